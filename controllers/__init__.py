@@ -1,0 +1,1 @@
+"""Classic autopilots and guidance laws (independent of shipgym.envs)."""

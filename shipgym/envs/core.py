@@ -1,0 +1,226 @@
+"""Generic single and NumPy-batched vector environments around a :class:`~shipgym.envs.tasks.Task`.
+
+``ShipEnv`` is a :class:`gymnasium.Env` holding a task of one row; ``ShipVectorEnv`` is a
+:class:`gymnasium.vector.VectorEnv` holding a task of ``num_envs`` rows with next-step
+autoreset (as Gymnasium's ``CartPoleVectorEnv``). Both step through the same task kernel, so
+the physics exists once. Sub-env ``i`` of a vector env reset with seed ``s`` draws from
+``np_random(s + i)``, the generator of a single env reset with seed ``s + i`` (the convention of
+``SyncVectorEnv``), so the two produce identical trajectories under identical actions.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from shipgym.envs.tasks import Task
+
+
+def _bad_action(action: Any, expected: int, reason: str) -> ValueError:
+    return ValueError(
+        f"action must be {expected} finite value(s) in [-1, 1] (out-of-range values are "
+        f"clipped), got {action!r}: {reason}"
+    )
+
+
+class _Spaces:
+    """Observation and action spaces shared by the single and the vector env."""
+
+    task_cls: ClassVar[type[Task]]
+
+    @classmethod
+    def _single_spaces(cls) -> tuple[spaces.Box, spaces.Box]:
+        t = cls.task_cls
+        obs = spaces.Box(-np.inf, np.inf, shape=(t.obs_dim,), dtype=np.float32)
+        act = spaces.Box(-1.0, 1.0, shape=(t.act_dim,), dtype=np.float32)
+        return obs, act
+
+
+class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
+    """A single ship environment. Subclasses set ``task_cls`` and document the task."""
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+
+    def __init__(self, render_mode: str | None = None, **task_kwargs: Any) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        self.render_mode = render_mode
+        self.task = self.task_cls(1, **task_kwargs)
+        self._task_kwargs = task_kwargs
+        self.observation_space, self.action_space = self._single_spaces()
+        self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.dt)}
+        self._renderer: Any = None
+        self._trail: list[tuple[float, float]] = []
+        self._obs = np.zeros(self.task.obs_dim, dtype=np.float32)
+
+    @property
+    def dt(self) -> float:
+        """Time step [s]."""
+        return self.task.dt
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """Names of the entries of ``info["state"]``."""
+        return self.task.model.state_names
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        self.task.reset_row(0, self.np_random, options)
+        self._trail = []
+        if self._renderer is not None:
+            self._renderer.reset_view()
+        if self.render_mode == "human":
+            self.render()
+        return self.task.obs[0].astype(np.float32), self.task.info(0)
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        task = self.task
+        try:
+            task.a[0] = action
+        except (ValueError, TypeError) as exc:
+            raise _bad_action(action, task.act_dim, str(exc)) from None
+        if task.step() >= 0:
+            raise _bad_action(action, task.act_dim, "it holds NaN or infinity")
+        if self.render_mode == "human":
+            self.render()
+        return (
+            task.obs[0].astype(np.float32),
+            float(task.rew[0]),
+            bool(task.term[0]),
+            False,
+            task.info(0),
+        )
+
+    def _draw_args(self, i: int) -> dict[str, Any]:
+        return {}
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode at creation")
+            return None
+        from shipgym.envs.rendering import TopDownRenderer
+
+        task = self.task
+        if self._renderer is None:
+            length, beam = self.ship_dimensions
+            self._renderer = TopDownRenderer(length, beam, self.render_mode, title=type(self).__name__)
+        x = task.x[0]
+        self._trail.append((float(x[0]), float(x[1])))
+        steps = int(task.steps[0])
+        return self._renderer.draw(
+            float(x[0]), float(x[1]), float(x[task.model.index("psi")]),
+            trail=np.asarray(self._trail),
+            current_speed=float(task.current[0, 0]),
+            current_direction=float(task.current[0, 1]),
+            text=f"t = {steps * task.dt:.0f} s",
+            **self._draw_args(0),
+        )
+
+    @property
+    def ship_dimensions(self) -> tuple[float, float]:
+        """Length and beam [m] used to draw the ship."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_renderer"] = None
+        return state
+
+
+class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
+    """NumPy-batched vector env with next-step autoreset over the same task kernel."""
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 10,
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        max_episode_steps: int | None = None,
+        render_mode: str | None = None,
+        **task_kwargs: Any,
+    ) -> None:
+        self.task = self.task_cls(num_envs, **task_kwargs)
+        self.num_envs = int(num_envs)
+        steps = self.task.max_episode_steps if max_episode_steps is None else max_episode_steps
+        if not isinstance(steps, int | np.integer) or steps < 1:
+            raise ValueError(f"max_episode_steps must be an integer >= 1, got {max_episode_steps!r}")
+        self.max_episode_steps = int(steps)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
+            )
+        self.render_mode = render_mode
+        self.single_observation_space, self.single_action_space = self._single_spaces()
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._rngs = [seeding.np_random(None)[0] for _ in range(self.num_envs)]
+        self._prev_done = np.zeros(self.num_envs, dtype=np.bool_)
+        self._single: ShipEnv | None = None
+
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        if seed is not None:
+            seeds = list(seed) if isinstance(seed, list | tuple) else [seed + i for i in range(self.num_envs)]
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
+            self._rngs = [seeding.np_random(s)[0] for s in seeds]
+        for i in range(self.num_envs):
+            self.task.reset_row(i, self._rngs[i], options)
+        self._prev_done[:] = False
+        return self.task.obs.astype(np.float32), {}
+
+    def step(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        task = self.task
+        try:
+            task.a[:] = actions
+        except (ValueError, TypeError) as exc:
+            raise _bad_action(actions, task.act_dim, f"expected shape ({self.num_envs}, {task.act_dim}); {exc}") from None
+        bad = task.step()
+        if bad >= 0:
+            raise _bad_action(actions[bad], task.act_dim, f"sub-env {bad}'s action holds NaN or infinity")
+        terminated = task.term.copy()
+        truncated = task.steps >= self.max_episode_steps
+        rewards = task.rew.copy()
+        if self._prev_done.any():
+            for i in np.flatnonzero(self._prev_done):
+                task.reset_row(int(i), self._rngs[i], None)
+            rewards[self._prev_done] = 0.0
+            terminated[self._prev_done] = False
+            truncated[self._prev_done] = False
+        self._prev_done = terminated | truncated
+        return task.obs.astype(np.float32), rewards, terminated, truncated, {"reason": task.reason.copy()}
+
+    def render(self) -> np.ndarray | None:
+        """Top-down view of sub-env 0 (``rgb_array`` only)."""
+        if self.render_mode is None:
+            return None
+        if self._single is None:
+            self._single = self.single_env_cls(render_mode="rgb_array")
+            self._single.task = self.task  # share the arrays; draw row 0
+        return self._single.render()
+
+    single_env_cls: ClassVar[type[ShipEnv]]

@@ -1,0 +1,161 @@
+"""Heading environments: ``shipgym/NomotoHeading-v0`` and ``shipgym/RVGHeading-v0``.
+
+Physics: :mod:`shipgym.models.nomoto` (seed 004 eq. 1-4, seed 002 eq. 1-3) and
+:mod:`shipgym.models.rvg` (seed 001 eq. 5-20); task logic: :func:`shipgym.envs.kernels.heading_kernel`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+from shipgym.envs.core import ShipEnv, ShipVectorEnv
+from shipgym.envs.tasks import NomotoHeadingTask, RVGHeadingTask
+from shipgym.models.rvg import BREADTH, LPP
+
+
+class NomotoHeadingEnv(ShipEnv):
+    """
+    ## Description
+
+    A ship steered by its rudder must reach and hold heading setpoints. The yaw dynamics are a
+    Nomoto-family model of the Mariner class cargo ship (L = 160.9 m, 7.7 m/s): first-order
+    Nomoto (default), second-order Nomoto, Norrbin or Bech (keyword ``model``), with a
+    first-order steering gear (2 s, 35 deg, 2.32 deg/s), a first-order surge model held at the
+    service shaft speed, and a constant current that carries the ship (it does not turn it).
+    Every ``setpoint_interval`` seconds (200 s) the setpoint changes by 10 to 60 deg to a random
+    side, four times, then holds. One step is 1 s of simulated time (one RK4 step).
+
+    ## Action Space
+
+    ``Box(-1, 1, (1,), float32)``: rudder command as a fraction of 35 deg (positive turns to
+    starboard). Values outside [-1, 1] are clipped; NaN or infinity raises ``ValueError``.
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (3,), float32)``:
+
+    | Num | Observation | Unit |
+    |-----|-------------|------|
+    | 0 | heading error ``ssa(psi_d - psi)`` | rad, in [-pi, pi) |
+    | 1 | yaw rate ``r`` | rad/s |
+    | 2 | rudder angle ``delta`` | rad, in [-0.61, 0.61] |
+
+    ## Rewards
+
+    ``-|psi_d - psi| / pi - 0.05 a^2`` per step, in [-1.05, 0]: 0 when on heading with the
+    rudder amidships.
+
+    ## Starting State
+
+    Heading uniform in [-pi, pi), speed 7.7 m/s, yaw rate and rudder zero, at the origin.
+    Current speed uniform in [0, ``max_current_speed``] (1 m/s) and direction uniform.
+
+    ## Episode End
+
+    Truncation after 800 steps (800 s) through ``max_episode_steps``. Termination only if the
+    integration blows up (``info["termination_reason"] == "numerical_blow_up"``; the last finite
+    observation is returned).
+
+    ## Arguments
+
+    ``gymnasium.make("shipgym/NomotoHeading-v0", model="nomoto1", max_current_speed=1.0,
+    setpoint_interval=200.0, render_mode=None)``. ``reset(options=...)`` accepts
+    ``current_speed`` [m/s], ``current_direction`` [rad, toward, clockwise from north],
+    ``initial_state`` (dict of named states or a full state vector) and ``setpoints`` (1 to 8
+    headings [rad], each held ``setpoint_interval`` seconds, the last held to the end).
+    ``info`` holds ``state`` (names in ``env.unwrapped.state_names``), ``current_speed``,
+    ``current_direction``, ``heading_error``, ``heading_setpoint`` and ``termination_reason``.
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    task_cls = NomotoHeadingTask
+
+    @property
+    def ship_dimensions(self) -> tuple[float, float]:
+        return (160.9, 23.2)
+
+    def _draw_args(self, i: int) -> dict[str, Any]:
+        return {"setpoint_heading": float(self.task.metrics(i)["heading_setpoint"])}
+
+
+class NomotoHeadingVectorEnv(ShipVectorEnv):
+    """NumPy-batched ``shipgym/NomotoHeading-v0`` (see :class:`NomotoHeadingEnv`)."""
+
+    task_cls = NomotoHeadingTask
+    single_env_cls = NomotoHeadingEnv
+
+
+class RVGHeadingEnv(ShipEnv):
+    """
+    ## Description
+
+    R/V Gunnerus (33.9 m, 3-DOF model of seed 001 with two azimuth pods) at service thrust
+    must reach and hold heading setpoints by turning both pods together. Every
+    ``setpoint_interval`` seconds (100 s) the setpoint changes by 10 to 45 deg to a random side,
+    three times. One step is 0.5 s (one RK4 step).
+
+    ## Action Space
+
+    ``Box(-1, 1, (1,), float32)``: common azimuth command of both pods as a fraction of
+    ``max_azimuth`` (35 deg). Positive azimuth turns the ship to port. Clipped to [-1, 1]; NaN
+    or infinity raises ``ValueError``. Thrust is held at 25 kN per pod (10 kn in calm water).
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (5,), float32)``:
+
+    | Num | Observation | Unit |
+    |-----|-------------|------|
+    | 0 | heading error ``ssa(psi_d - psi)`` | rad |
+    | 1 | yaw rate ``r`` | rad/s |
+    | 2 | azimuth of pod 1 (both are equal) | rad |
+    | 3 | surge velocity ``u`` | m/s |
+    | 4 | sway velocity ``v`` | m/s |
+
+    ## Rewards
+
+    ``-|psi_d - psi| / pi - 0.05 a^2`` per step, in [-1.05, 0].
+
+    ## Starting State
+
+    Heading uniform, moving straight at 5.14 m/s through the water (plus the current), pods at
+    service thrust and zero azimuth. Current uniform in [0, ``max_current_speed``] (0.5 m/s),
+    direction uniform.
+
+    ## Episode End
+
+    Truncation after 600 steps (300 s); termination only on a numerical blow-up.
+
+    ## Arguments
+
+    ``gymnasium.make("shipgym/RVGHeading-v0", max_current_speed=0.5, max_azimuth=0.61,
+    setpoint_interval=100.0, render_mode=None)``. Reset options and ``info`` as for
+    ``NomotoHeading-v0``.
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    task_cls = RVGHeadingTask
+
+    @property
+    def ship_dimensions(self) -> tuple[float, float]:
+        return (LPP, BREADTH)
+
+    def _draw_args(self, i: int) -> dict[str, Any]:
+        return {"setpoint_heading": float(self.task.metrics(i)["heading_setpoint"])}
+
+
+class RVGHeadingVectorEnv(ShipVectorEnv):
+    """NumPy-batched ``shipgym/RVGHeading-v0`` (see :class:`RVGHeadingEnv`)."""
+
+    task_cls = RVGHeadingTask
+    single_env_cls = RVGHeadingEnv
+
+
+__all__ = ["NomotoHeadingEnv", "NomotoHeadingVectorEnv", "RVGHeadingEnv", "RVGHeadingVectorEnv"]

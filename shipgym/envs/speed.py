@@ -1,0 +1,71 @@
+"""Speed environment ``shipgym/RVGSpeed-v0`` (seed 001 model, seed 004 section 1.2 task)."""
+
+from __future__ import annotations
+
+from shipgym.envs.core import ShipEnv, ShipVectorEnv
+from shipgym.envs.tasks import RVGSpeedTask
+from shipgym.models.rvg import BREADTH, LPP
+
+
+class RVGSpeedEnv(ShipEnv):
+    """
+    ## Description
+
+    R/V Gunnerus must reach and hold speed setpoints (speed through the water, what a speed
+    log measures) with the thrust of its two pods, azimuths at zero. Two setpoints uniform in
+    [1.5, 6] m/s, each held ``setpoint_interval`` seconds (200 s). One step is 0.5 s.
+
+    ## Action Space
+
+    ``Box(-1, 1, (1,), float32)``: common thrust command, -1 for zero thrust and +1 for the
+    bollard thrust of 121.7 kN per pod; the physics limits it further to
+    ``121.7 kN (1 - u_r / 8.7 m/s)``. Clipped to [-1, 1]; NaN or infinity raises ``ValueError``.
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (4,), float32)``:
+
+    | Num | Observation | Unit |
+    |-----|-------------|------|
+    | 0 | speed error ``u_d - u_r`` | m/s |
+    | 1 | surge speed through the water ``u_r`` | m/s |
+    | 2 | thrust of pod 1 over the bollard thrust | - |
+    | 3 | speed setpoint ``u_d`` | m/s |
+
+    ## Rewards
+
+    ``-|u_d - u_r| / 2 - 0.05 (T / T_bollard)^2`` per step.
+
+    ## Starting State
+
+    Heading uniform, straight ahead at a speed uniform in [0, 5] m/s through the water, zero
+    thrust. Current uniform in [0, ``max_current_speed``] (0.5 m/s), direction uniform.
+
+    ## Episode End
+
+    Truncation after 800 steps (400 s); termination only on a numerical blow-up.
+
+    ## Arguments
+
+    ``gymnasium.make("shipgym/RVGSpeed-v0", max_current_speed=0.5, setpoint_interval=200.0,
+    render_mode=None)``. Reset options: ``current_speed``, ``current_direction``,
+    ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s] >= 0). ``info`` holds ``state``,
+    the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    task_cls = RVGSpeedTask
+
+    @property
+    def ship_dimensions(self) -> tuple[float, float]:
+        return (LPP, BREADTH)
+
+
+class RVGSpeedVectorEnv(ShipVectorEnv):
+    """NumPy-batched ``shipgym/RVGSpeed-v0`` (see :class:`RVGSpeedEnv`)."""
+
+    task_cls = RVGSpeedTask
+    single_env_cls = RVGSpeedEnv

@@ -1,0 +1,84 @@
+"""Target tracking environment ``shipgym/RVGTargetTracking-v0`` (seed 004 section 2.3 task)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from shipgym.envs.core import ShipEnv, ShipVectorEnv
+from shipgym.envs.tasks import RVGTargetTask
+from shipgym.models.rvg import BREADTH, LPP
+
+
+class RVGTargetTrackingEnv(ShipEnv):
+    """
+    ## Description
+
+    R/V Gunnerus must intercept a target moving at constant velocity and hold a set distance
+    (``distance``, 50 m) from it. The target starts 300-800 m away within 60 deg of the bow,
+    on a random course at 1-3 m/s. One step is 0.5 s.
+
+    ## Action Space
+
+    ``Box(-1, 1, (2,), float32)``: ``[azimuth, thrust]`` as in ``RVGPathFollowing-v0``.
+
+    ## Observation Space
+
+    ``Box(-inf, inf, (10,), float32)``:
+
+    | Num | Observation | Unit |
+    |-----|-------------|------|
+    | 0, 1 | target position relative to the ship, body frame (forward, starboard) | m |
+    | 2, 3 | target velocity relative to the ship, body frame | m/s |
+    | 4 | distance error ``|p_t - p| - d_set`` | m |
+    | 5, 6, 7 | ``u``, ``v``, ``r`` | m/s, m/s, rad/s |
+    | 8 | azimuth of pod 1 | rad |
+    | 9 | thrust of pod 1 over the bollard thrust | - |
+
+    ## Rewards
+
+    ``-min(|d - d_set| / 100 m, 2) - 0.05 |a|^2`` per step; -10 when the distance exceeds
+    ``max_distance``.
+
+    ## Starting State
+
+    Heading uniform, straight ahead at 5.14 m/s through the water at service thrust; current
+    uniform in [0, ``max_current_speed``] (0.5 m/s), direction uniform.
+
+    ## Episode End
+
+    Terminates when the distance exceeds ``max_distance`` (3 km) or on a numerical blow-up;
+    truncation after 1600 steps (800 s).
+
+    ## Arguments
+
+    ``gymnasium.make("shipgym/RVGTargetTracking-v0", max_current_speed=0.5, distance=50.0,
+    max_distance=3000.0, render_mode=None)``. Reset options: ``current_speed``,
+    ``current_direction``, ``initial_state``, ``target_position`` and ``target_velocity``
+    ((north, east) in m and m/s), ``distance`` [m]. ``info`` holds ``state``, the current,
+    ``distance``, ``distance_error`` and ``termination_reason``.
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    task_cls = RVGTargetTask
+
+    @property
+    def ship_dimensions(self) -> tuple[float, float]:
+        return (LPP, BREADTH)
+
+    def _draw_args(self, i: int) -> dict[str, Any]:
+        vn, ve = self.task.target_vel[i]
+        return {
+            "target": (float(self.task.target[i, 0]), float(self.task.target[i, 1])),
+            "target_heading": math.atan2(ve, vn),
+        }
+
+
+class RVGTargetTrackingVectorEnv(ShipVectorEnv):
+    """NumPy-batched ``shipgym/RVGTargetTracking-v0`` (see :class:`RVGTargetTrackingEnv`)."""
+
+    task_cls = RVGTargetTask
+    single_env_cls = RVGTargetTrackingEnv

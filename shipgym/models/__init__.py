@@ -1,0 +1,41 @@
+"""Pure vessel dynamics: parameters, batched state derivatives, actuators, current, RK4.
+
+Every model is one Numba kernel shared by all users; see :mod:`shipgym.models.integrate`.
+"""
+
+from shipgym.models.angles import ssa
+from shipgym.models.base import (
+    MODEL_NAMES,
+    NOMOTO_MODEL_NAMES,
+    ShipModel,
+    SimulationResult,
+    make_model,
+)
+from shipgym.models.current import Current, current_ned
+from shipgym.models.nomoto import (
+    BechParams,
+    Nomoto1Params,
+    Nomoto2Params,
+    NorrbinParams,
+    SteeringGear,
+    SurgeModel,
+)
+from shipgym.models.rvg import RVGParams
+
+__all__ = [
+    "MODEL_NAMES",
+    "NOMOTO_MODEL_NAMES",
+    "BechParams",
+    "Current",
+    "Nomoto1Params",
+    "Nomoto2Params",
+    "NorrbinParams",
+    "RVGParams",
+    "ShipModel",
+    "SimulationResult",
+    "SteeringGear",
+    "SurgeModel",
+    "current_ned",
+    "make_model",
+    "ssa",
+]

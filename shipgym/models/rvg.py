@@ -1,0 +1,256 @@
+"""R/V Gunnerus (RVG) 3-DOF manoeuvring model with two azimuth pods (seed 001 eq. 5-20).
+
+Kinematics (eq. 5-6): ``eta' = R_z(psi) nu`` with ``eta = [x, y, psi]``, ``nu = [u, v, r]``.
+
+Current (eq. 7-9): earth-frame ``nu_c^n = V_c [cos beta_c, sin beta_c, 0]``, body-frame
+``nu_c = R_z(psi)^T nu_c^n`` and ``nu_c' = [r v_c, -r u_c, 0]``.
+
+Kinetics (eq. 10-12), with ``nu_r = nu - nu_c``::
+
+    nu' = (M_rb + M_a)^-1 (F - C_rb(nu) nu - C_a(nu_r) nu_r - D(nu_r) nu_r + M_a nu_c')
+
+Coriolis (eq. 14) in the skew-symmetric form ``C(nu)`` with
+``C[0,2] = -C[2,0] = -(m22 v + (m23 + m32) r / 2)`` and ``C[1,2] = -C[2,1] = m11 u``. (The seed's
+text prints ``m22 u`` in ``C[2,0]``; that breaks skew-symmetry and is a typo, Fossen 2011 eq. 6.43.)
+Damping (eq. 15): ``D(nu_r) = D_l + D_u |u_r| + D_v |v_r| + D_r |r|``.
+
+Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`` and
+``alpha' = sat_rate((sat(alpha_c) - alpha) / tau_alpha)``; each pod at ``(x_t, y_t)`` gives
+``F = T [cos a, sin a, -y_t cos a + x_t sin a]``, so positive azimuth on aft pods turns the ship
+to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
+200 rpm (RVG_PARAMETERS.md). Foil lift of the pods is not in eq. 19 and is not modelled here.
+
+State ``[x, y, psi, u, v, r, T_1, T_2, alpha_1, alpha_2]`` in [m, m, rad, m/s, m/s, rad/s, N, N,
+rad, rad]; input ``[T_1c, T_2c, alpha_1c, alpha_2c]``. Pod 1 is port (y < 0), pod 2 starboard.
+
+With zero thrust the relative-velocity dynamics are ``M nu_r' + (C_rb + C_a)(nu_r) nu_r +
+D nu_r = 0`` for an irrotational current (Fossen 2011 property 8.1 holds for eq. 14), so with a
+symmetric ``M`` the kinetic energy relative to the water, ``nu_r^T M nu_r / 2``, never grows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from shipgym.models._jit import kernel
+
+RVG_STATES = ("x", "y", "psi", "u", "v", "r", "T1", "T2", "alpha1", "alpha2")
+RVG_INPUTS = ("T1_c", "T2_c", "alpha1_c", "alpha2_c")
+IX, IY, IPSI, IU, IV, IR, IT1, IT2, IA1, IA2 = range(10)
+
+LPP = 33.9  # [m], seed 001 Table 1
+DRAUGHT = 2.7  # [m], seed 001 Table 1
+BREADTH = 9.6  # [m], seed 001 Table 1
+SERVICE_SPEED = 5.144  # [m/s], 10 kn (RVG_PARAMETERS.md)
+
+_D_V = 0.5 * 0.5 * LPP * DRAUGHT * 1000.0  # 23 611.35, RVG_PARAMETERS.md
+#: Yaw quadratic damping. The source's 0.75 D_v L^4 / 64 (3.65e8) has units of N m s^2 * m, one
+#: length too many. We use the cross-flow-consistent D_v L^3 / 32 (integral of the sway
+#: cross-flow drag times x|x| over the hull, with the hull of length L about its middle): 2.87e7.
+YAW_QUADRATIC_DAMPING = _D_V * LPP**3 / 32.0
+
+
+def _m3(rows: tuple[tuple[float, float, float], ...]) -> np.ndarray:
+    return np.array(rows, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class RVGParams:
+    """Gunnerus parameter set (MCSim "revised" set of 2022-10-31; see RVG_PARAMETERS.md).
+
+    Matrices are 3x3 in the order (surge, sway, yaw), SI units (kg, kg m, kg m^2; N s/m, ...).
+
+    Attributes
+    ----------
+    mass : float
+        Ship mass [kg] (ShipX/VERES, 574 127.69 kg).
+    yaw_inertia : float
+        ``I_z`` [kg m^2] (radius of gyration 0.25 Lpp: 4.1237e7).
+    added_mass : numpy.ndarray
+        ``M_a`` [kg, kg m, kg m^2]. VERES gives a non-symmetric matrix (off-diagonals -473 277.78
+        and -571 162.06); we use the symmetric mean -522 220 in both places, so the model is
+        passive (energy never created by the hull) as an ideal-fluid added mass must be.
+    linear_damping : numpy.ndarray
+        ``D_l`` (0.05/0.2/0.2 x the VERES viscous values).
+    surge_quadratic_damping, sway_quadratic_damping, yaw_quadratic_damping : float
+        Diagonal entries of ``D_u``, ``D_v``, ``D_r`` (1 671.60; 23 611.35; see
+        ``YAW_QUADRATIC_DAMPING`` for the deliberate choice of 2.87e7).
+    pod_x, pod_y : tuple of float
+        Pod positions [m] relative to the CG, port pod first (-15.56, -2.7) and (-15.56, 2.7).
+    thrust_time_constant, azimuth_time_constant : float
+        Actuator time constants [s] (1 s, "a pure guess" in the source).
+    azimuth_max_rate : float
+        [rad/s] (10 deg/s).
+    azimuth_max : float
+        Azimuth angle limit [rad] for commands (the pods can turn 360 deg; 180 deg by default).
+    bollard_thrust : float
+        Per-pod thrust limit at zero speed [N] (121.7 kN at 200 rpm).
+    thrust_zero_speed : float
+        Relative surge speed [m/s] where the thrust limit falls to zero (8.7 m/s).
+    service_thrust : float
+        Per-pod thrust [N] that holds the 10 kn service speed in calm water (25 kN).
+    """
+
+    mass: float = 574_127.69
+    yaw_inertia: float = 4.1237e7
+    added_mass: np.ndarray = field(
+        default_factory=lambda: _m3(
+            ((26_599.25, 0.0, 0.0), (0.0, 132_619.44, -522_220.0), (0.0, -522_220.0, 13_320_142.0))
+        )
+    )
+    linear_damping: np.ndarray = field(
+        default_factory=lambda: np.diag([1_117.598, 22_288.64, 1_949_686.6])
+    )
+    surge_quadratic_damping: float = 0.5 * 0.125 * BREADTH * DRAUGHT * 1000.0
+    sway_quadratic_damping: float = _D_V
+    yaw_quadratic_damping: float = YAW_QUADRATIC_DAMPING
+    pod_x: tuple[float, float] = (-15.56, -15.56)
+    pod_y: tuple[float, float] = (-2.7, 2.7)
+    thrust_time_constant: float = 1.0
+    azimuth_time_constant: float = 1.0
+    azimuth_max_rate: float = math.radians(10.0)
+    azimuth_max: float = math.pi
+    bollard_thrust: float = 121.7e3
+    thrust_zero_speed: float = 8.7
+    service_thrust: float = 25.0e3
+
+    def __post_init__(self) -> None:
+        for name in ("added_mass", "linear_damping"):
+            value = np.asarray(getattr(self, name), dtype=np.float64)
+            if value.shape != (3, 3) or not np.all(np.isfinite(value)):
+                raise ValueError(f"RVGParams.{name} must be a finite 3x3 matrix, got {value!r}")
+            value = value.copy()
+            value.flags.writeable = False
+            object.__setattr__(self, name, value)
+        for name in (
+            "mass", "yaw_inertia", "thrust_time_constant", "azimuth_time_constant",
+            "azimuth_max_rate", "azimuth_max", "bollard_thrust", "thrust_zero_speed",
+        ):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
+
+    @property
+    def rigid_body_mass(self) -> np.ndarray:
+        """``M_rb = diag(m, m, I_z)`` (origin at the CG)."""
+        return np.diag([self.mass, self.mass, self.yaw_inertia])
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """``M = M_rb + M_a``."""
+        return self.rigid_body_mass + self.added_mass
+
+    def max_thrust(self, relative_surge: float) -> float:
+        """Per-pod thrust limit [N] at relative surge speed ``u_r`` [m/s]."""
+        factor = min(max(1.0 - relative_surge / self.thrust_zero_speed, 0.0), 1.0)
+        return self.bollard_thrust * factor
+
+
+# Parameter-vector layout for the kernel.
+P_MINV, P_MA, P_DL = 0, 9, 18
+P_MRB = 27  # m11, m22, (m23 + m32) / 2 of M_rb
+P_MA_C = 30  # a11, a22, (a23 + a32) / 2 of M_a, for C_a
+P_DQ = 33  # D_u[0,0], D_v[1,1], D_r[2,2]
+P_POD = 36  # x1, y1, x2, y2
+P_TAU_T, P_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_U0 = 40, 41, 42, 43, 44, 45
+P_SIZE = 46
+
+
+def pack_rvg(params: RVGParams) -> np.ndarray:
+    """Parameter vector that :func:`rvg_row` reads."""
+    p = np.zeros(P_SIZE)
+    M = params.mass_matrix
+    Mrb = params.rigid_body_mass
+    Ma = params.added_mass
+    p[P_MINV : P_MINV + 9] = np.linalg.inv(M).ravel()
+    p[P_MA : P_MA + 9] = Ma.ravel()
+    p[P_DL : P_DL + 9] = params.linear_damping.ravel()
+    p[P_MRB : P_MRB + 3] = (Mrb[0, 0], Mrb[1, 1], 0.5 * (Mrb[1, 2] + Mrb[2, 1]))
+    p[P_MA_C : P_MA_C + 3] = (Ma[0, 0], Ma[1, 1], 0.5 * (Ma[1, 2] + Ma[2, 1]))
+    p[P_DQ : P_DQ + 3] = (
+        params.surge_quadratic_damping,
+        params.sway_quadratic_damping,
+        params.yaw_quadratic_damping,
+    )
+    p[P_POD : P_POD + 4] = (params.pod_x[0], params.pod_y[0], params.pod_x[1], params.pod_y[1])
+    p[P_TAU_T] = params.thrust_time_constant
+    p[P_TAU_A] = params.azimuth_time_constant
+    p[P_ARATE] = params.azimuth_max_rate
+    p[P_AMAX] = params.azimuth_max
+    p[P_TBOLL] = params.bollard_thrust
+    p[P_U0] = params.thrust_zero_speed
+    return p
+
+
+@kernel
+def _pod_state_rates(x, u, p, out, i, ur):  # noqa: ANN001, ANN202
+    """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
+    tmax = p[P_TBOLL] * min(max(1.0 - ur / p[P_U0], 0.0), 1.0)
+    amax = p[P_AMAX]
+    rate = p[P_ARATE]
+    for k in range(2):
+        tc = min(max(u[i, k], 0.0), tmax)
+        out[i, IT1 + k] = (tc - x[i, IT1 + k]) / p[P_TAU_T]
+        ac = min(max(u[i, 2 + k], -amax), amax)
+        out[i, IA1 + k] = min(max((ac - x[i, IA1 + k]) / p[P_TAU_A], -rate), rate)
+
+
+@kernel
+def rvg_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
+    """RVG 3-DOF derivative of row ``i`` (seed 001 eq. 5-20)."""
+    psi = x[i, IPSI]
+    cs = math.cos(psi)
+    sn = math.sin(psi)
+    uu = x[i, IU]
+    vv = x[i, IV]
+    r = x[i, IR]
+    # eq. (6)
+    out[i, IX] = cs * uu - sn * vv
+    out[i, IY] = sn * uu + cs * vv
+    out[i, IPSI] = r
+    # eq. (8)-(10)
+    uc = c[i, 0] * cs + c[i, 1] * sn
+    vc = -c[i, 0] * sn + c[i, 1] * cs
+    ur = uu - uc
+    vr = vv - vc
+    # eq. (19)-(20), summed over both pods
+    fx = 0.0
+    fy = 0.0
+    fn = 0.0
+    for k in range(2):
+        thrust = x[i, IT1 + k]
+        ca = math.cos(x[i, IA1 + k])
+        sa = math.sin(x[i, IA1 + k])
+        fx += thrust * ca
+        fy += thrust * sa
+        fn += thrust * (-p[P_POD + 2 * k + 1] * ca + p[P_POD + 2 * k] * sa)
+    # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
+    m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
+    a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
+    c_rb0 = -(m22 * vv + m23 * r) * r
+    c_rb1 = m11 * uu * r
+    c_rb2 = (m22 * vv + m23 * r) * uu - m11 * uu * vv
+    c_a0 = -(a22 * vr + a23 * r) * r
+    c_a1 = a11 * ur * r
+    c_a2 = (a22 * vr + a23 * r) * ur - a11 * ur * vr
+    # eq. (15): D(nu_r) nu_r
+    d0 = p[P_DL] * ur + p[P_DL + 1] * vr + p[P_DL + 2] * r + p[P_DQ] * abs(ur) * ur
+    d1 = p[P_DL + 3] * ur + p[P_DL + 4] * vr + p[P_DL + 5] * r + p[P_DQ + 1] * abs(vr) * vr
+    d2 = p[P_DL + 6] * ur + p[P_DL + 7] * vr + p[P_DL + 8] * r + p[P_DQ + 2] * abs(r) * r
+    # eq. (9): nu_c' = [r v_c, -r u_c, 0]; M_a nu_c'
+    ncd0 = r * vc
+    ncd1 = -r * uc
+    ma0 = p[P_MA] * ncd0 + p[P_MA + 1] * ncd1
+    ma1 = p[P_MA + 3] * ncd0 + p[P_MA + 4] * ncd1
+    ma2 = p[P_MA + 6] * ncd0 + p[P_MA + 7] * ncd1
+    # eq. (12)
+    b0 = fx - c_rb0 - c_a0 - d0 + ma0
+    b1 = fy - c_rb1 - c_a1 - d1 + ma1
+    b2 = fn - c_rb2 - c_a2 - d2 + ma2
+    out[i, IU] = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
+    out[i, IV] = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
+    out[i, IR] = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
+    _pod_state_rates(x, u, p, out, i, ur)
