@@ -293,6 +293,68 @@ def test_rvg_at_rest_in_water_drifts_with_current(
     np.testing.assert_allclose(_relative_velocity(res.states, current), 0.0, atol=1e-12)
 
 
+@pytest.mark.parametrize(("speed", "direction"), [(1.0, 2.0), (1.5, -0.5), (0.6, math.pi)])
+def test_rvg_relative_motion_does_not_depend_on_current(speed: float, direction: float) -> None:
+    """Irrotational constant current (property 8.1): in the water's frame nothing changes.
+
+    A ship started with the same velocity relative to the water, with the same commands,
+    has the same relative velocity, heading, yaw rate and actuator states as in still water,
+    and its position is the still-water one plus ``current * t``.
+    """
+    model = make_model("rvg3dof")
+    dt, n_steps = 0.1, 600
+    t = np.arange(n_steps) * dt
+    inputs = np.column_stack(
+        (
+            np.where(t < 15.0, 1e6, 30e3 + 10e3 * np.sin(0.05 * t)),  # saturated at first
+            20e3 + 5e3 * np.cos(0.03 * t),
+            0.3 * np.sin(0.02 * t) + 0.1,
+            -0.2 + 0.4 * (t > 20.0),
+        )
+    )
+    x0 = np.array([0.0, 0.0, 0.4, 4.0, 0.3, -0.02, 20e3, 35e3, 0.2, -0.1])
+    still = model.simulate(x0, inputs, dt)
+
+    current = np.array(Current(speed, direction).ned)
+    xc = x0.copy()
+    uc0, vc0 = _body_current(current, np.array(x0[2]))
+    xc[3] += uc0
+    xc[4] += vc0
+    moving = model.simulate(xc, inputs, dt, current=current)
+    in_water = moving.states.copy()
+    in_water[:, 0] -= current[0] * moving.time
+    in_water[:, 1] -= current[1] * moving.time
+    in_water[:, 3:6] = _relative_velocity(moving.states, current)
+
+    assert np.max(still["T1"]) > 60e3  # the speed-dependent thrust limit was active
+    scale = np.maximum(np.max(np.abs(still.states), axis=0), 1.0)
+    # equal up to the RK4 truncation error (the map nu -> nu_r depends on psi)
+    np.testing.assert_allclose(in_water / scale, still.states / scale, rtol=0, atol=1e-8)
+
+
+def test_rvg_pod_forces_at_rest_follow_eq20() -> None:
+    """At rest in still water only the pods act (eq. 20).
+
+    ``M nu' = sum_k T_k [cos a_k, sin a_k, x_k sin a_k - y_k cos a_k]``.
+    """
+    params = RVGParams()
+    model = make_model("rvg3dof", params)
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        thrust = rng.uniform(0.0, 100e3, 2)
+        alpha = rng.uniform(-math.pi, math.pi, 2)
+        x = np.array([0.0, 0.0, rng.uniform(-3, 3), 0.0, 0.0, 0.0, *thrust, *alpha])
+        nu_dot = model.deriv(x, [*thrust, *alpha])[0, 3:6]
+        force = np.zeros(3)
+        for k in range(2):
+            ca, sa = math.cos(alpha[k]), math.sin(alpha[k])
+            force += thrust[k] * np.array([ca, sa, params.pod_x[k] * sa - params.pod_y[k] * ca])
+        np.testing.assert_allclose(params.mass_matrix @ nu_dot, force, rtol=1e-9, atol=1e-6)
+    # port pod alone, straight ahead: pushes the port side forward, the bow goes to starboard
+    x = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 50e3, 0.0, 0.0, 0.0])
+    assert model.deriv(x, [50e3, 0.0, 0.0, 0.0])[0, 5] > 0.0
+
+
 def test_current_direction_convention() -> None:
     """``direction`` is where the water goes, clockwise from north: pi/2 moves it east."""
     north, east = Current(2.0, math.pi / 2).ned

@@ -1,8 +1,10 @@
 """Batched task kernels: action mapping, one RK4 step, observations, rewards, terminations.
 
 One kernel per task family, looping over the rows of a batch. The single environment calls
-it with one row and the vector environment with many, so both run the same compiled code and
-the same physics (:func:`shipgym.models.integrate.rk4_step`). Conventions: NED, heading
+it with one row and the vector environment with many, so both run the same code and the same
+physics (:func:`shipgym.models.integrate.rk4_step`). Each kernel is compiled twice from one
+source: serially for small batches and with a ``prange`` row loop for large ones
+(``PARALLEL_MIN_ROWS``); both give bit-identical results. Conventions: NED, heading
 clockwise from north, SI units and radians; ``a`` is the normalised action in [-1, 1], already
 clipped, mapped to the model input by ``u = u0 + B a``.
 
@@ -19,7 +21,9 @@ import math
 
 import numpy as np
 
-from shipgym.models._jit import kernel
+from numba import prange
+
+from shipgym.models._jit import kernel, parallel_kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
 from shipgym.models.integrate import rk4_step
 from shipgym.models.rvg import P_TBOLL
@@ -38,31 +42,42 @@ def first_nonfinite_row(a):  # noqa: ANN001, ANN201
     return -1
 
 
-@kernel
-def integrate_actions(model_id, x, u, p, c, dt, a, u0, B):  # noqa: ANN001, ANN201
-    """Clip actions to [-1, 1], map them to inputs (``u = u0 + B a``), take one RK4 step."""
-    n, na = a.shape
-    nu = u0.shape[0]
-    for i in range(n):
+@row_kernel
+def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
+    """Clip row ``i`` of the actions to [-1, 1] and map it to inputs, ``u = u0 + B a``."""
+    na = a.shape[1]
+    for k in range(na):
+        a[i, k] = min(max(a[i, k], -1.0), 1.0)
+    for j in range(u0.shape[0]):
+        acc = u0[j]
         for k in range(na):
-            a[i, k] = min(max(a[i, k], -1.0), 1.0)
-        for j in range(nu):
-            acc = u0[j]
-            for k in range(na):
-                acc += B[j, k] * a[i, k]
-            u[i, j] = acc
+            acc += B[j, k] * a[i, k]
+        u[i, j] = acc
+
+
+def _integrate_actions(model_id, x, u, p, c, dt, a, u0, B):  # noqa: ANN001, ANN202
+    for i in prange(x.shape[0]):
+        _map_action(a, u0, B, u, i)
     rk4_step(model_id, x, u, p, c, dt)
 
 
-@kernel
-def _finite_row(x, i):  # noqa: ANN001, ANN202
+@row_kernel
+def _begin_row(advance, x, i, steps, rew, term, reason):  # noqa: ANN001, ANN202
+    """Count the step of row ``i`` and clear its flags; False (and terminate) if not finite."""
+    if advance:
+        steps[i] += 1
+    reason[i] = RUNNING
+    term[i] = False
     for j in range(x.shape[1]):
         if not math.isfinite(x[i, j]):
+            rew[i] = 0.0
+            term[i] = True
+            reason[i] = BLOW_UP
             return False
     return True
 
 
-@kernel
+@row_kernel
 def _action_cost(a, i):  # noqa: ANN001, ANN202
     s = 0.0
     for k in range(a.shape[1]):
@@ -70,11 +85,10 @@ def _action_cost(a, i):  # noqa: ANN001, ANN202
     return s
 
 
-@kernel
-def heading_kernel(  # noqa: ANN201, PLR0913
+def _heading(  # noqa: PLR0913
     advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     ipsi, obs_idx, schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
-):
+):  # noqa: ANN202
     """Heading task: hold ``schedule[i, steps[i] // hold_steps]``.
 
     Observation ``[ssa(psi_d - psi), x[obs_idx]...]``; reward
@@ -84,32 +98,23 @@ def heading_kernel(  # noqa: ANN201, PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate_actions(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B)
     n_sp = schedule.shape[1]
-    for i in range(x.shape[0]):
-        if advance:
-            steps[i] += 1
-        reason[i] = RUNNING
-        term[i] = False
-        if not _finite_row(x, i):
-            rew[i] = 0.0
-            term[i] = True
-            reason[i] = BLOW_UP
-            continue
-        psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-        e = ssa_scalar(psi_d - x[i, ipsi])
-        obs[i, 0] = e
-        for k in range(obs_idx.shape[0]):
-            obs[i, 1 + k] = x[i, obs_idx[k]]
-        rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
+    for i in prange(x.shape[0]):
+        if _begin_row(advance, x, i, steps, rew, term, reason):
+            psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+            e = ssa_scalar(psi_d - x[i, ipsi])
+            obs[i, 0] = e
+            for k in range(obs_idx.shape[0]):
+                obs[i, 1 + k] = x[i, obs_idx[k]]
+            rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
     return -1
 
 
-@kernel
-def speed_kernel(  # noqa: ANN201, PLR0913
+def _speed(  # noqa: PLR0913
     advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
-):
+):  # noqa: ANN202
     """RVG speed task: hold the speed through the water ``u_r`` at the scheduled setpoint.
 
     Observation ``[u_d - u_r, u_r, T_1 / T_bollard, u_d]``; reward
@@ -119,129 +124,107 @@ def speed_kernel(  # noqa: ANN201, PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate_actions(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B)
     n_sp = schedule.shape[1]
     tb = p[P_TBOLL]
-    for i in range(x.shape[0]):
-        if advance:
-            steps[i] += 1
-        reason[i] = RUNNING
-        term[i] = False
-        if not _finite_row(x, i):
-            rew[i] = 0.0
-            term[i] = True
-            reason[i] = BLOW_UP
-            continue
-        psi = x[i, 2]
-        ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
-        ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-        frac = x[i, 6] / tb
-        obs[i, 0] = ud - ur
-        obs[i, 1] = ur
-        obs[i, 2] = frac
-        obs[i, 3] = ud
-        rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
+    for i in prange(x.shape[0]):
+        if _begin_row(advance, x, i, steps, rew, term, reason):
+            psi = x[i, 2]
+            ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
+            ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+            frac = x[i, 6] / tb
+            obs[i, 0] = ud - ur
+            obs[i, 1] = ur
+            obs[i, 2] = frac
+            obs[i, 3] = ud
+            rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
     return -1
 
 
-@kernel
-def path_geometry(px, py, wp, n_wp, seg, i):  # noqa: ANN001, ANN201
-    """Cross-track error, along-track distance left, path angle and next turn on segment seg[i].
+@row_kernel
+def path_geometry(px, py, tangent, leg_length, seg, i):  # noqa: ANN001, ANN201
+    """Cross-track error and along-track distance left on the active leg ``seg[i]``.
 
     ``e = -(x - x_k) sin(chi_p) + (y - y_k) cos(chi_p)`` is positive when the ship is to the
-    right (starboard side) of the path (Fossen 2011, eq. 10.55).
+    right (starboard side) of the path (Fossen 2011, eq. 10.55). ``tangent[i, k]`` holds
+    ``(x_k, y_k, cos chi_p, sin chi_p)`` of leg ``k``.
     """
     k = seg[i]
-    dn = wp[i, k + 1, 0] - wp[i, k, 0]
-    de = wp[i, k + 1, 1] - wp[i, k, 1]
-    length = math.hypot(dn, de)
-    chi = math.atan2(de, dn)
-    s = (px - wp[i, k, 0]) * math.cos(chi) + (py - wp[i, k, 1]) * math.sin(chi)
-    e = -(px - wp[i, k, 0]) * math.sin(chi) + (py - wp[i, k, 1]) * math.cos(chi)
-    turn = 0.0
-    if k + 2 < n_wp[i]:
-        chi_next = math.atan2(wp[i, k + 2, 1] - wp[i, k + 1, 1], wp[i, k + 2, 0] - wp[i, k + 1, 0])
-        turn = ssa_scalar(chi_next - chi)
-    return e, length - s, chi, turn
+    dn = px - tangent[i, k, 0]
+    de = py - tangent[i, k, 1]
+    cs = tangent[i, k, 2]
+    sn = tangent[i, k, 3]
+    return -dn * sn + de * cs, leg_length[i, k] - (dn * cs + de * sn)
 
 
-@kernel
-def path_kernel(  # noqa: ANN201, PLR0913
+def _path(  # noqa: PLR0913
     advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    wp, n_wp, seg, accept_radius, max_cross_track, ref_speed,  # noqa: ANN001
-    steps, obs, rew, term, reason,  # noqa: ANN001
-):
-    """RVG path following along straight segments between waypoints.
+    tangent, leg_length, leg_angle, turn, n_wp, seg, accept_radius,  # noqa: ANN001
+    max_cross_track, ref_speed, steps, obs, rew, term, reason,  # noqa: ANN001
+):  # noqa: ANN202
+    """RVG path following along straight legs between waypoints.
 
-    The active segment switches when the ship is within ``accept_radius`` of its end waypoint or
-    has passed it along the track. Observation ``[e, ssa(chi_p - psi), s_left, turn, u, v, r,
+    The active leg switches when the ship is within ``accept_radius`` of its end waypoint or has
+    passed it along the track. Observation ``[e, ssa(chi_p - psi), s_left, turn, u, v, r,
     alpha_1, T_1 / T_bollard]``. Reward per step ``-min(|e| / 50, 1) - 0.1 |chi_p - psi| / pi
     + 0.5 progress / (ref_speed dt) - 0.05 |a|^2``; +10 on reaching the last waypoint, -10 when
     ``|e| > max_cross_track``.
     """
     n = x.shape[0]
     s_before = np.empty(n)
-    for i in range(n):
-        s_before[i] = path_geometry(x[i, 0], x[i, 1], wp, n_wp, seg, i)[1]
+    for i in prange(n):
+        s_before[i] = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate_actions(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B)
     tb = p[P_TBOLL]
-    for i in range(n):
-        if advance:
-            steps[i] += 1
-        reason[i] = RUNNING
-        term[i] = False
-        if not _finite_row(x, i):
-            rew[i] = 0.0
-            term[i] = True
-            reason[i] = BLOW_UP
-            continue
-        e, s_left, chi, turn = path_geometry(x[i, 0], x[i, 1], wp, n_wp, seg, i)
-        progress = s_before[i] - s_left
-        dist_end = math.hypot(
-            x[i, 0] - wp[i, seg[i] + 1, 0], x[i, 1] - wp[i, seg[i] + 1, 1]
-        )
-        bonus = 0.0
-        if dist_end < accept_radius or s_left < 0.0:
-            if seg[i] + 2 < n_wp[i]:
-                seg[i] += 1
-                e, s_left, chi, turn = path_geometry(x[i, 0], x[i, 1], wp, n_wp, seg, i)
-            else:
+    for i in prange(n):
+        if _begin_row(advance, x, i, steps, rew, term, reason):
+            e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+            progress = s_before[i] - s_left
+            k = seg[i]
+            dist_end = math.hypot(
+                x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
+            )
+            bonus = 0.0
+            if dist_end < accept_radius or s_left < 0.0:
+                if k + 2 < n_wp[i]:
+                    seg[i] = k + 1
+                    e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+                else:
+                    term[i] = True
+                    reason[i] = SUCCESS
+                    bonus = 10.0
+            if abs(e) > max_cross_track:
                 term[i] = True
-                reason[i] = SUCCESS
-                bonus = 10.0
-        if abs(e) > max_cross_track:
-            term[i] = True
-            reason[i] = FAILURE
-            bonus = -10.0
-        chi_err = ssa_scalar(chi - x[i, 2])
-        obs[i, 0] = e
-        obs[i, 1] = chi_err
-        obs[i, 2] = s_left
-        obs[i, 3] = turn
-        obs[i, 4] = x[i, 3]
-        obs[i, 5] = x[i, 4]
-        obs[i, 6] = x[i, 5]
-        obs[i, 7] = x[i, 8]
-        obs[i, 8] = x[i, 6] / tb
-        rew[i] = (
-            -min(abs(e) / 50.0, 1.0)
-            - 0.1 * abs(chi_err) / math.pi
-            + 0.5 * progress / (ref_speed * dt)
-            - 0.05 * _action_cost(a, i)
-            + bonus
-        )
+                reason[i] = FAILURE
+                bonus = -10.0
+            chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
+            obs[i, 0] = e
+            obs[i, 1] = chi_err
+            obs[i, 2] = s_left
+            obs[i, 3] = turn[i, seg[i]]
+            obs[i, 4] = x[i, 3]
+            obs[i, 5] = x[i, 4]
+            obs[i, 6] = x[i, 5]
+            obs[i, 7] = x[i, 8]
+            obs[i, 8] = x[i, 6] / tb
+            rew[i] = (
+                -min(abs(e) / 50.0, 1.0)
+                - 0.1 * abs(chi_err) / math.pi
+                + 0.5 * progress / (ref_speed * dt)
+                - 0.05 * _action_cost(a, i)
+                + bonus
+            )
     return -1
 
 
-@kernel
-def target_kernel(  # noqa: ANN201, PLR0913
+def _target(  # noqa: PLR0913
     advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     target, target_vel, distance, max_distance, steps, obs, rew, term, reason,  # noqa: ANN001
-):
+):  # noqa: ANN202
     """RVG target tracking: close on a target moving at constant velocity and hold ``distance``.
 
     Observation ``[dx_b, dy_b, dvx_b, dvy_b, |p_t - p| - d_set, u, v, r, alpha_1, T_1 / T_b]``
@@ -253,46 +236,46 @@ def target_kernel(  # noqa: ANN201, PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate_actions(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B)
     tb = p[P_TBOLL]
-    for i in range(x.shape[0]):
-        if advance:
-            steps[i] += 1
-        reason[i] = RUNNING
-        term[i] = False
+    for i in prange(x.shape[0]):
         if advance:
             target[i, 0] += target_vel[i, 0] * dt
             target[i, 1] += target_vel[i, 1] * dt
-        if not _finite_row(x, i):
-            rew[i] = 0.0
-            term[i] = True
-            reason[i] = BLOW_UP
-            continue
-        psi = x[i, 2]
-        cs = math.cos(psi)
-        sn = math.sin(psi)
-        dn = target[i, 0] - x[i, 0]
-        de = target[i, 1] - x[i, 1]
-        # ship velocity over ground in NED
-        vn = cs * x[i, 3] - sn * x[i, 4]
-        ve = sn * x[i, 3] + cs * x[i, 4]
-        rvn = target_vel[i, 0] - vn
-        rve = target_vel[i, 1] - ve
-        d = math.hypot(dn, de)
-        err = d - distance[i]
-        obs[i, 0] = cs * dn + sn * de
-        obs[i, 1] = -sn * dn + cs * de
-        obs[i, 2] = cs * rvn + sn * rve
-        obs[i, 3] = -sn * rvn + cs * rve
-        obs[i, 4] = err
-        obs[i, 5] = x[i, 3]
-        obs[i, 6] = x[i, 4]
-        obs[i, 7] = x[i, 5]
-        obs[i, 8] = x[i, 8]
-        obs[i, 9] = x[i, 6] / tb
-        rew[i] = -min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
-        if d > max_distance:
-            term[i] = True
-            reason[i] = FAILURE
-            rew[i] -= 10.0
+        if _begin_row(advance, x, i, steps, rew, term, reason):
+            psi = x[i, 2]
+            cs = math.cos(psi)
+            sn = math.sin(psi)
+            dn = target[i, 0] - x[i, 0]
+            de = target[i, 1] - x[i, 1]
+            vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
+            ve = sn * x[i, 3] + cs * x[i, 4]
+            rvn = target_vel[i, 0] - vn
+            rve = target_vel[i, 1] - ve
+            d = math.hypot(dn, de)
+            err = d - distance[i]
+            obs[i, 0] = cs * dn + sn * de
+            obs[i, 1] = -sn * dn + cs * de
+            obs[i, 2] = cs * rvn + sn * rve
+            obs[i, 3] = -sn * rvn + cs * rve
+            obs[i, 4] = err
+            obs[i, 5] = x[i, 3]
+            obs[i, 6] = x[i, 4]
+            obs[i, 7] = x[i, 5]
+            obs[i, 8] = x[i, 8]
+            obs[i, 9] = x[i, 6] / tb
+            rew[i] = -min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
+            if d > max_distance:
+                term[i] = True
+                reason[i] = FAILURE
+                rew[i] -= 10.0
     return -1
+
+
+#: (serial, parallel) compilations of each task kernel, chosen by batch size.
+integrate = row_kernel(_integrate_actions)
+KERNELS = {
+    name: (kernel(func), parallel_kernel(func))
+    for name, func in (("heading", _heading), ("speed", _speed), ("path", _path),
+                       ("target", _target))
+}

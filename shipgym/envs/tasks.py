@@ -21,6 +21,7 @@ import numpy as np
 from shipgym.envs import kernels
 from shipgym.models import NOMOTO_MODEL_NAMES, ShipModel, make_model
 from shipgym.models.angles import ssa
+from shipgym.models.integrate import PARALLEL_MIN_ROWS
 from shipgym.models.rvg import IT1, IT2, IU, IV, LPP, SERVICE_SPEED
 
 COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
@@ -86,13 +87,17 @@ class Task:
         self.steps = np.zeros(n, dtype=np.int64)
         self.u0 = np.zeros(model.nu)
         self.B = np.zeros((model.nu, self.act_dim))
+        self._step_args: tuple[Any, ...] | None = None
 
     # --- to be provided by each task -------------------------------------------------------
     def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
         raise NotImplementedError
 
-    def _kernel(self) -> Any:
-        raise NotImplementedError
+    kernel_name: ClassVar[str]
+
+    def _kernel(self, n: int) -> Any:
+        serial, parallel = kernels.KERNELS[self.kernel_name]
+        return parallel if n >= PARALLEL_MIN_ROWS else serial
 
     def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
         raise NotImplementedError
@@ -105,21 +110,23 @@ class Task:
         raise NotImplementedError
 
     # --- shared ------------------------------------------------------------------------------
-    def _run(self, advance: bool, rows: slice) -> int:
+    def _args(self, advance: bool, rows: slice) -> tuple[Any, ...]:
         x, u, c, a, obs, rew, term, reason, steps = (
             arr[rows]
             for arr in (self.x, self.u, self.c, self.a, self.obs, self.rew, self.term,
                         self.reason, self.steps)
         )
         m = self.model
-        return self._kernel()(
+        return (
             advance, m.model_id, x, u, m.p, c, self.dt, a, self.u0, self.B,
             *self._kernel_args(rows), steps, obs, rew, term, reason,
         )
 
     def step(self) -> int:
         """Step every row with the actions in ``self.a``; returns a bad action row or -1."""
-        return self._run(True, slice(None))
+        if self._step_args is None:  # built once: every array is updated in place
+            self._step_args = self._args(True, slice(None))
+        return self._kernel(self.n)(*self._step_args)
 
     def reset_row(
         self, i: int, rng: np.random.Generator, options: Mapping[str, Any] | None = None
@@ -152,7 +159,7 @@ class Task:
         self.steps[i] = 0
         self.a[i] = 0.0
         self._reset_task(i, rng, options)
-        self._run(False, slice(i, i + 1))
+        self._kernel(1)(*self._args(False, slice(i, i + 1)))
 
     def _parse_state(self, value: Any, state: np.ndarray) -> np.ndarray:
         names = self.model.state_names
@@ -207,8 +214,7 @@ class HeadingTask(Task):
         self.ipsi = model.index("psi")
         self.obs_idx = np.array([model.index(s) for s in self.obs_state_names], dtype=np.int64)
 
-    def _kernel(self) -> Any:
-        return kernels.heading_kernel
+    kernel_name = "heading"
 
     def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
         return (self.ipsi, self.obs_idx, self.schedule[rows], self.hold_steps)
@@ -357,8 +363,7 @@ class RVGSpeedTask(RVGMixin, Task):
         self.u0[:] = (half, half, 0.0, 0.0)
         self.B[0, 0] = self.B[1, 0] = half
 
-    def _kernel(self) -> Any:
-        return kernels.speed_kernel
+    kernel_name = "speed"
 
     def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
         return (self.schedule[rows], self.hold_steps)
@@ -411,6 +416,10 @@ class RVGPathTask(RVGMixin, Task):
         self.accept_radius = float(accept_radius)
         self.max_cross_track = float(max_cross_track)
         self.wp = np.zeros((n, self.max_waypoints, 2))
+        self.tangent = np.zeros((n, self.max_waypoints, 4))  # x_k, y_k, cos chi_k, sin chi_k
+        self.leg_length = np.zeros((n, self.max_waypoints))
+        self.leg_angle = np.zeros((n, self.max_waypoints))
+        self.turn = np.zeros((n, self.max_waypoints))
         self.n_wp = np.full(n, 2, dtype=np.int64)
         self.seg = np.zeros(n, dtype=np.int64)
         half = 0.5 * self.bollard
@@ -418,12 +427,12 @@ class RVGPathTask(RVGMixin, Task):
         self.B[2, 0] = self.B[3, 0] = self.max_azimuth
         self.B[0, 1] = self.B[1, 1] = half
 
-    def _kernel(self) -> Any:
-        return kernels.path_kernel
+    kernel_name = "path"
 
     def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
-        return (self.wp[rows], self.n_wp[rows], self.seg[rows], self.accept_radius,
-                self.max_cross_track, SERVICE_SPEED)
+        return (self.tangent[rows], self.leg_length[rows], self.leg_angle[rows], self.turn[rows],
+                self.n_wp[rows], self.seg[rows], self.accept_radius, self.max_cross_track,
+                SERVICE_SPEED)
 
     def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
         x = super()._initial_state(rng)
@@ -460,8 +469,20 @@ class RVGPathTask(RVGMixin, Task):
             self.x[i, 2] = ssa(chi0 + self.x[i, 2])
             self._add_current(i, options)
         m = path.shape[0]
+        legs = np.diff(path, axis=0)
+        angle = np.arctan2(legs[:, 1], legs[:, 0])
         self.wp[i] = path[-1]
         self.wp[i, :m] = path
+        self.tangent[i] = 0.0
+        self.tangent[i, :m, :2] = path
+        self.tangent[i, : m - 1, 2] = np.cos(angle)
+        self.tangent[i, : m - 1, 3] = np.sin(angle)
+        self.leg_length[i] = 0.0
+        self.leg_length[i, : m - 1] = np.hypot(legs[:, 0], legs[:, 1])
+        self.leg_angle[i] = 0.0
+        self.leg_angle[i, : m - 1] = angle
+        self.turn[i] = 0.0
+        self.turn[i, : m - 2] = ssa(np.diff(angle))
         self.n_wp[i] = m
         self.seg[i] = 0
 
@@ -511,8 +532,7 @@ class RVGTargetTask(RVGMixin, Task):
         self.B[2, 0] = self.B[3, 0] = self.max_azimuth
         self.B[0, 1] = self.B[1, 1] = half
 
-    def _kernel(self) -> Any:
-        return kernels.target_kernel
+    kernel_name = "target"
 
     def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
         return (self.target[rows], self.target_vel[rows], self.distance[rows], self.max_distance)

@@ -22,4 +22,14 @@ _CACHE = os.environ.get("SHIPGYM_NO_CACHE", "") in ("", "0")
 
 def kernel(func: F) -> F:
     """Compile ``func`` as a cached, serial Numba kernel (no fast-math: results are exact IEEE)."""
-    return numba.njit(cache=_CACHE, nogil=True)(func)  # type: ignore[return-value]
+    return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(func)  # type: ignore[return-value]
+
+
+def row_kernel(func: F) -> F:
+    """Compile a per-ship kernel that Numba inlines into the batch loops that call it."""
+    return numba.njit(cache=_CACHE, nogil=True, inline="always", error_model="numpy")(func)  # type: ignore[return-value]
+
+
+def parallel_kernel(func: F) -> F:
+    """Compile a batch kernel whose ``prange`` loop runs on all cores."""
+    return numba.njit(cache=_CACHE, nogil=True, parallel=True)(func)  # type: ignore[return-value]

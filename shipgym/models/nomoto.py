@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from shipgym.models._jit import kernel
+from shipgym.models._jit import row_kernel
 
 # Shared state and input indices of the Nomoto family.
 IX, IY, IPSI, IU, IR, IDELTA, IRDOT = 0, 1, 2, 3, 4, 5, 6
@@ -257,60 +257,60 @@ def pack_nomoto(
     return np.array(head + yaw.coefficients(), dtype=np.float64)
 
 
-@kernel
-def _actuators_and_kinematics(x, u, p, c, out, i):  # noqa: ANN001, ANN202
-    """Steering gear, surge and position kinematics of row ``i``; returns ``delta'``."""
+@row_kernel
+def _actuators_and_kinematics(x, u, p, c, out):  # noqa: ANN001, ANN202
+    """Steering gear, surge and position kinematics; returns ``delta'``."""
     dmax = p[P_DMAX]
     rate = p[P_DRATE]
-    dc = min(max(u[i, 0], -dmax), dmax)
-    ddot = min(max((dc - x[i, IDELTA]) / p[P_TDELTA], -rate), rate)
-    psi = x[i, IPSI]
-    speed = x[i, IU]
-    out[i, IX] = speed * math.cos(psi) + c[i, 0]
-    out[i, IY] = speed * math.sin(psi) + c[i, 1]
-    out[i, IPSI] = x[i, IR]
-    out[i, IU] = (p[P_KU] * u[i, 1] - speed) / p[P_TU]
-    out[i, IDELTA] = ddot
+    dc = min(max(u[0], -dmax), dmax)
+    ddot = min(max((dc - x[IDELTA]) / p[P_TDELTA], -rate), rate)
+    psi = x[IPSI]
+    speed = x[IU]
+    out[IX] = speed * math.cos(psi) + c[0]
+    out[IY] = speed * math.sin(psi) + c[1]
+    out[IPSI] = x[IR]
+    out[IU] = (p[P_KU] * u[1] - speed) / p[P_TU]
+    out[IDELTA] = ddot
     return ddot
 
 
-@kernel
-def nomoto1_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
-    """First-order Nomoto derivative of row ``i`` (seed 004 eq. 2)."""
-    _actuators_and_kinematics(x, u, p, c, out, i)
+@row_kernel
+def nomoto1_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+    """First-order Nomoto derivative (seed 004 eq. 2)."""
+    _actuators_and_kinematics(x, u, p, c, out)
     K, T = p[P_YAW], p[P_YAW + 1]
-    out[i, IR] = (K * x[i, IDELTA] - x[i, IR]) / T
+    out[IR] = (K * x[IDELTA] - x[IR]) / T
 
 
-@kernel
-def norrbin_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
-    """Norrbin derivative of row ``i`` (seed 002 eq. 1-3, seed 004 eq. 4)."""
-    _actuators_and_kinematics(x, u, p, c, out, i)
+@row_kernel
+def norrbin_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+    """Norrbin derivative (seed 002 eq. 1-3, seed 004 eq. 4)."""
+    _actuators_and_kinematics(x, u, p, c, out)
     K, T = p[P_YAW], p[P_YAW + 1]
     n0, n1, n2, n3 = p[P_YAW + 2], p[P_YAW + 3], p[P_YAW + 4], p[P_YAW + 5]
-    r = x[i, IR]
+    r = x[IR]
     hn = n3 * r * r * r + n2 * r * abs(r) + n1 * r + n0
-    out[i, IR] = (K * x[i, IDELTA] - hn) / T
+    out[IR] = (K * x[IDELTA] - hn) / T
 
 
-@kernel
-def nomoto2_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
-    """Second-order Nomoto derivative of row ``i`` (seed 004 eq. 1)."""
-    ddot = _actuators_and_kinematics(x, u, p, c, out, i)
+@row_kernel
+def nomoto2_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+    """Second-order Nomoto derivative (seed 004 eq. 1)."""
+    ddot = _actuators_and_kinematics(x, u, p, c, out)
     K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
-    rdot = x[i, IRDOT]
-    out[i, IR] = rdot
-    out[i, IRDOT] = (K * (x[i, IDELTA] + T3 * ddot) - (T1 + T2) * rdot - x[i, IR]) / (T1 * T2)
+    rdot = x[IRDOT]
+    out[IR] = rdot
+    out[IRDOT] = (K * (x[IDELTA] + T3 * ddot) - (T1 + T2) * rdot - x[IR]) / (T1 * T2)
 
 
-@kernel
-def bech_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
-    """Bech derivative of row ``i`` (seed 004 eq. 3)."""
-    ddot = _actuators_and_kinematics(x, u, p, c, out, i)
+@row_kernel
+def bech_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+    """Bech derivative (seed 004 eq. 3)."""
+    ddot = _actuators_and_kinematics(x, u, p, c, out)
     K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
     b0, b1, b2, b3 = p[P_YAW + 4], p[P_YAW + 5], p[P_YAW + 6], p[P_YAW + 7]
-    r = x[i, IR]
-    rdot = x[i, IRDOT]
+    r = x[IR]
+    rdot = x[IRDOT]
     hb = b3 * r * r * r + b2 * r * abs(r) + b1 * r + b0
-    out[i, IR] = rdot
-    out[i, IRDOT] = (K * (x[i, IDELTA] + T3 * ddot) - (T1 + T2) * rdot - K * hb) / (T1 * T2)
+    out[IR] = rdot
+    out[IRDOT] = (K * (x[IDELTA] + T3 * ddot) - (T1 + T2) * rdot - K * hb) / (T1 * T2)

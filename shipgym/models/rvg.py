@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from shipgym.models._jit import kernel
+from shipgym.models._jit import row_kernel
 
 RVG_STATES = ("x", "y", "psi", "u", "v", "r", "T1", "T2", "alpha1", "alpha2")
 RVG_INPUTS = ("T1_c", "T2_c", "alpha1_c", "alpha2_c")
@@ -43,10 +43,11 @@ IX, IY, IPSI, IU, IV, IR, IT1, IT2, IA1, IA2 = range(10)
 
 LPP = 33.9  # [m], seed 001 Table 1
 DRAUGHT = 2.7  # [m], seed 001 Table 1
+VERES_DRAUGHT = 2.786  # [m], the draught of the VERES run behind the damping (RVG_PARAMETERS.md)
 BREADTH = 9.6  # [m], seed 001 Table 1
 SERVICE_SPEED = 5.144  # [m/s], 10 kn (RVG_PARAMETERS.md)
 
-_D_V = 0.5 * 0.5 * LPP * DRAUGHT * 1000.0  # 23 611.35, RVG_PARAMETERS.md
+_D_V = 0.5 * 0.5 * LPP * VERES_DRAUGHT * 1000.0  # 23 611.35, RVG_PARAMETERS.md
 #: Yaw quadratic damping. The source's 0.75 D_v L^4 / 64 (3.65e8) has units of N m s^2 * m, one
 #: length too many. We use the cross-flow-consistent D_v L^3 / 32 (integral of the sway
 #: cross-flow drag times x|x| over the hull, with the hull of length L about its middle): 2.87e7.
@@ -104,7 +105,7 @@ class RVGParams:
     linear_damping: np.ndarray = field(
         default_factory=lambda: np.diag([1_117.598, 22_288.64, 1_949_686.6])
     )
-    surge_quadratic_damping: float = 0.5 * 0.125 * BREADTH * DRAUGHT * 1000.0
+    surge_quadratic_damping: float = 0.5 * 0.125 * BREADTH * VERES_DRAUGHT * 1000.0
     sway_quadratic_damping: float = _D_V
     yaw_quadratic_damping: float = YAW_QUADRATIC_DAMPING
     pod_x: tuple[float, float] = (-15.56, -15.56)
@@ -185,35 +186,35 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     return p
 
 
-@kernel
-def _pod_state_rates(x, u, p, out, i, ur):  # noqa: ANN001, ANN202
+@row_kernel
+def _pod_state_rates(x, u, p, out, ur):  # noqa: ANN001, ANN202
     """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
     tmax = p[P_TBOLL] * min(max(1.0 - ur / p[P_U0], 0.0), 1.0)
     amax = p[P_AMAX]
     rate = p[P_ARATE]
     for k in range(2):
-        tc = min(max(u[i, k], 0.0), tmax)
-        out[i, IT1 + k] = (tc - x[i, IT1 + k]) / p[P_TAU_T]
-        ac = min(max(u[i, 2 + k], -amax), amax)
-        out[i, IA1 + k] = min(max((ac - x[i, IA1 + k]) / p[P_TAU_A], -rate), rate)
+        tc = min(max(u[k], 0.0), tmax)
+        out[IT1 + k] = (tc - x[IT1 + k]) / p[P_TAU_T]
+        ac = min(max(u[2 + k], -amax), amax)
+        out[IA1 + k] = min(max((ac - x[IA1 + k]) / p[P_TAU_A], -rate), rate)
 
 
-@kernel
-def rvg_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
-    """RVG 3-DOF derivative of row ``i`` (seed 001 eq. 5-20)."""
-    psi = x[i, IPSI]
+@row_kernel
+def rvg_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+    """RVG 3-DOF derivative (seed 001 eq. 5-20)."""
+    psi = x[IPSI]
     cs = math.cos(psi)
     sn = math.sin(psi)
-    uu = x[i, IU]
-    vv = x[i, IV]
-    r = x[i, IR]
+    uu = x[IU]
+    vv = x[IV]
+    r = x[IR]
     # eq. (6)
-    out[i, IX] = cs * uu - sn * vv
-    out[i, IY] = sn * uu + cs * vv
-    out[i, IPSI] = r
+    out[IX] = cs * uu - sn * vv
+    out[IY] = sn * uu + cs * vv
+    out[IPSI] = r
     # eq. (8)-(10)
-    uc = c[i, 0] * cs + c[i, 1] * sn
-    vc = -c[i, 0] * sn + c[i, 1] * cs
+    uc = c[0] * cs + c[1] * sn
+    vc = -c[0] * sn + c[1] * cs
     ur = uu - uc
     vr = vv - vc
     # eq. (19)-(20), summed over both pods
@@ -221,9 +222,9 @@ def rvg_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
     fy = 0.0
     fn = 0.0
     for k in range(2):
-        thrust = x[i, IT1 + k]
-        ca = math.cos(x[i, IA1 + k])
-        sa = math.sin(x[i, IA1 + k])
+        thrust = x[IT1 + k]
+        ca = math.cos(x[IA1 + k])
+        sa = math.sin(x[IA1 + k])
         fx += thrust * ca
         fy += thrust * sa
         fn += thrust * (-p[P_POD + 2 * k + 1] * ca + p[P_POD + 2 * k] * sa)
@@ -250,7 +251,7 @@ def rvg_row(x, u, p, c, out, i):  # noqa: ANN001, ANN201
     b0 = fx - c_rb0 - c_a0 - d0 + ma0
     b1 = fy - c_rb1 - c_a1 - d1 + ma1
     b2 = fn - c_rb2 - c_a2 - d2 + ma2
-    out[i, IU] = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
-    out[i, IV] = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
-    out[i, IR] = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
-    _pod_state_rates(x, u, p, out, i, ur)
+    out[IU] = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
+    out[IV] = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
+    out[IR] = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
+    _pod_state_rates(x, u, p, out, ur)
