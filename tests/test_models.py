@@ -466,14 +466,6 @@ def test_rvg_straight_line_speed_at_service_thrust() -> None:
     assert np.all(np.diff(res["u"]) >= 0.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "rvg.py computes the quadratic surge/sway drag with DRAUGHT=2.7 m (1620, 22 882.5) "
-        "instead of the documented 1671.60 and 23 611.35 (draught 2.786 m), so service_thrust "
-        "holds 5.22 m/s instead of the documented 10 kn"
-    ),
-)
 def test_rvg_service_thrust_holds_documented_service_speed() -> None:
     _, res = _rvg_straight_run_at_service_thrust()
     assert res["u"][-1] == pytest.approx(5.144, rel=5e-3)
