@@ -1,16 +1,23 @@
 """The one place that decides how shipgym compiles its physics kernels.
 
-Every model kernel is a Numba ``njit`` function with on-disk caching, so the same compiled
-code serves the single environment, the vector environment, the manoeuvres and system
-identification (ARCHITECTURE.md, "One physics, many users"). Set ``SHIPGYM_NO_CACHE=1``
-to compile without the on-disk cache (useful while editing a kernel that another cached
-kernel calls, since Numba only invalidates a cache when its own file changes).
+Every model and task kernel is a Numba ``njit`` function, so the same compiled code serves the
+single environment, the vector environment, the manoeuvres and system identification
+(ARCHITECTURE.md, "One physics, many users").
+
+Compiled code is cached on disk in a directory keyed by a hash of every source that holds
+kernels (``shipgym/models/*.py`` and ``shipgym/envs/kernels.py``):
+Numba alone only invalidates a cached function when its own file changes, and a kernel that
+inlines a changed kernel from another file would otherwise load stale machine code. The
+directory is ``$SHIPGYM_CACHE_DIR`` or ``~/.cache/shipgym/numba-<hash>``; set
+``SHIPGYM_NO_CACHE=1`` to compile without any cache.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, TypeVar
 
 import numba
@@ -20,16 +27,42 @@ F = TypeVar("F", bound=Callable[..., Any])
 _CACHE = os.environ.get("SHIPGYM_NO_CACHE", "") in ("", "0")
 
 
+def _cache_dir() -> str:
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha1(numba.__version__.encode())
+    for path in sorted([*root.glob("models/*.py"), root / "envs" / "kernels.py"]):
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.environ.get("SHIPGYM_CACHE_DIR") or os.path.join(
+        base, "shipgym", f"numba-{digest.hexdigest()[:16]}"
+    )
+
+
+_CACHE_DIR = _cache_dir() if _CACHE else ""
+
+
+def _compile(func: F, **options: Any) -> F:
+    if not _CACHE:
+        return numba.njit(**options)(func)  # type: ignore[return-value]
+    previous = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = _CACHE_DIR  # read once, when the dispatcher sets up its cache
+    try:
+        return numba.njit(cache=True, **options)(func)  # type: ignore[return-value]
+    finally:
+        numba.config.CACHE_DIR = previous
+
+
 def kernel(func: F) -> F:
-    """Compile ``func`` as a cached, serial Numba kernel (no fast-math: results are exact IEEE)."""
-    return numba.njit(cache=_CACHE, nogil=True, error_model="numpy")(func)  # type: ignore[return-value]
+    """Compile ``func`` as a serial kernel (no fast-math: results are exact IEEE)."""
+    return _compile(func, nogil=True, error_model="numpy")
 
 
 def row_kernel(func: F) -> F:
     """Compile a per-ship kernel that Numba inlines into the batch loops that call it."""
-    return numba.njit(cache=_CACHE, nogil=True, inline="always", error_model="numpy")(func)  # type: ignore[return-value]
+    return _compile(func, nogil=True, error_model="numpy", inline="always")
 
 
 def parallel_kernel(func: F) -> F:
-    """Compile a batch kernel whose ``prange`` loop runs on all cores."""
-    return numba.njit(cache=_CACHE, nogil=True, parallel=True)(func)  # type: ignore[return-value]
+    """Compile a batch kernel whose ``prange`` loops run on all cores."""
+    return _compile(func, nogil=True, parallel=True)
