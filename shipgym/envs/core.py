@@ -77,7 +77,7 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
-        self.task.reset_row(0, self.np_random, options)
+        self.task.reset_rows([0], [self.np_random], options)
         self._trail = []
         if self._renderer is not None:
             self._renderer.reset_view()
@@ -186,8 +186,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             if len(seeds) != self.num_envs:
                 raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
-        for i in range(self.num_envs):
-            self.task.reset_row(i, self._rngs[i], options)
+        self.task.reset_rows(range(self.num_envs), self._rngs, options)
         self._prev_done[:] = False
         return self.task.obs.astype(np.float32), {}
 
@@ -206,8 +205,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         truncated = task.steps >= self.max_episode_steps
         rewards = task.rew.copy()
         if self._prev_done.any():
-            for i in np.flatnonzero(self._prev_done):
-                task.reset_row(int(i), self._rngs[i], None)
+            rows = np.flatnonzero(self._prev_done)
+            task.reset_rows(rows, [self._rngs[i] for i in rows])
             rewards[self._prev_done] = 0.0
             terminated[self._prev_done] = False
             truncated[self._prev_done] = False

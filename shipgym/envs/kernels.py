@@ -9,8 +9,9 @@ clockwise from north, SI units and radians; ``a`` is the normalised action in [-
 clipped, mapped to the model input by ``u = u0 + B a``.
 
 Every task kernel returns the first row whose action is not finite (then nothing was
-stepped), or -1. It takes ``advance`` first: ``True`` steps the batch, ``False`` only computes the
-observations of the current state (after a reset). It writes ``obs``, ``rew``, ``term`` and ``reason`` (0 running,
+stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps the whole
+batch, ``False`` only computes the observations of the current state (after a reset); either
+way only the rows listed in ``rows`` get new observations, rewards and flags. It writes ``obs``, ``rew``, ``term`` and ``reason`` (0 running,
 1 numerical blow-up, 2 success, 3 failure) for every row. A row whose state is no longer finite
 after the step keeps its previous observation, gets reward 0 and terminates with reason 1.
 """
@@ -55,17 +56,17 @@ def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
         u[i, j] = acc
 
 
-def _integrate_actions(model_id, x, u, p, c, dt, a, u0, B):  # noqa: ANN001, ANN202
+def _integrate_actions(model_id, x, u, p, c, dt, a, u0, B, steps):  # noqa: ANN001, ANN202
+    """Map every row's action to inputs, count the step and advance all rows by one RK4 step."""
     for i in prange(x.shape[0]):
         _map_action(a, u0, B, u, i)
+        steps[i] += 1
     rk4_step(model_id, x, u, p, c, dt)
 
 
 @row_kernel
-def _begin_row(advance, x, i, steps, rew, term, reason):  # noqa: ANN001, ANN202
-    """Count the step of row ``i`` and clear its flags; False (and terminate) if not finite."""
-    if advance:
-        steps[i] += 1
+def _begin_row(x, i, rew, term, reason):  # noqa: ANN001, ANN202
+    """Clear the flags of row ``i``; False (and terminate with a blow-up) if it is not finite."""
     reason[i] = RUNNING
     term[i] = False
     for j in range(x.shape[1]):
@@ -86,7 +87,7 @@ def _action_cost(a, i):  # noqa: ANN001, ANN202
 
 
 def _heading(  # noqa: PLR0913
-    advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
+    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     ipsi, obs_idx, schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
 ):  # noqa: ANN202
     """Heading task: hold ``schedule[i, steps[i] // hold_steps]``.
@@ -98,10 +99,11 @@ def _heading(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     n_sp = schedule.shape[1]
-    for i in prange(x.shape[0]):
-        if _begin_row(advance, x, i, steps, rew, term, reason):
+    for j in prange(rows.shape[0]):
+        i = rows[j]
+        if _begin_row(x, i, rew, term, reason):
             psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
             e = ssa_scalar(psi_d - x[i, ipsi])
             obs[i, 0] = e
@@ -112,7 +114,7 @@ def _heading(  # noqa: PLR0913
 
 
 def _speed(  # noqa: PLR0913
-    advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
+    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
 ):  # noqa: ANN202
     """RVG speed task: hold the speed through the water ``u_r`` at the scheduled setpoint.
@@ -124,11 +126,12 @@ def _speed(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     n_sp = schedule.shape[1]
     tb = p[P_TBOLL]
-    for i in prange(x.shape[0]):
-        if _begin_row(advance, x, i, steps, rew, term, reason):
+    for j in prange(rows.shape[0]):
+        i = rows[j]
+        if _begin_row(x, i, rew, term, reason):
             psi = x[i, 2]
             ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
             ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
@@ -158,7 +161,7 @@ def path_geometry(px, py, tangent, leg_length, seg, i):  # noqa: ANN001, ANN201
 
 
 def _path(  # noqa: PLR0913
-    advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
+    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     tangent, leg_length, leg_angle, turn, n_wp, seg, accept_radius,  # noqa: ANN001
     max_cross_track, ref_speed, steps, obs, rew, term, reason,  # noqa: ANN001
 ):  # noqa: ANN202
@@ -172,16 +175,18 @@ def _path(  # noqa: PLR0913
     """
     n = x.shape[0]
     s_before = np.empty(n)
-    for i in prange(n):
+    for j in prange(rows.shape[0]):
+        i = rows[j]
         s_before[i] = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     tb = p[P_TBOLL]
-    for i in prange(n):
-        if _begin_row(advance, x, i, steps, rew, term, reason):
+    for j in prange(rows.shape[0]):
+        i = rows[j]
+        if _begin_row(x, i, rew, term, reason):
             e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
             progress = s_before[i] - s_left
             k = seg[i]
@@ -222,7 +227,7 @@ def _path(  # noqa: PLR0913
 
 
 def _target(  # noqa: PLR0913
-    advance, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
+    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     target, target_vel, distance, max_distance, steps, obs, rew, term, reason,  # noqa: ANN001
 ):  # noqa: ANN202
     """RVG target tracking: close on a target moving at constant velocity and hold ``distance``.
@@ -236,13 +241,14 @@ def _target(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B)
+        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     tb = p[P_TBOLL]
-    for i in prange(x.shape[0]):
+    for j in prange(rows.shape[0]):
+        i = rows[j]
         if advance:
             target[i, 0] += target_vel[i, 0] * dt
             target[i, 1] += target_vel[i, 1] * dt
-        if _begin_row(advance, x, i, steps, rew, term, reason):
+        if _begin_row(x, i, rew, term, reason):
             psi = x[i, 2]
             cs = math.cos(psi)
             sn = math.sin(psi)

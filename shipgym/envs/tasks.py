@@ -13,7 +13,7 @@ drawn uniformly from ``[0, max_current_speed]`` and the direction uniformly from
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
@@ -90,7 +90,7 @@ class Task:
         self._step_args: tuple[Any, ...] | None = None
 
     # --- to be provided by each task -------------------------------------------------------
-    def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
+    def _kernel_args(self) -> tuple[Any, ...]:
         raise NotImplementedError
 
     kernel_name: ClassVar[str]
@@ -110,28 +110,26 @@ class Task:
         raise NotImplementedError
 
     # --- shared ------------------------------------------------------------------------------
-    def _args(self, advance: bool, rows: slice) -> tuple[Any, ...]:
-        x, u, c, a, obs, rew, term, reason, steps = (
-            arr[rows]
-            for arr in (self.x, self.u, self.c, self.a, self.obs, self.rew, self.term,
-                        self.reason, self.steps)
-        )
+    def _args(self, advance: bool, rows: np.ndarray) -> tuple[Any, ...]:
         m = self.model
         return (
-            advance, m.model_id, x, u, m.p, c, self.dt, a, self.u0, self.B,
-            *self._kernel_args(rows), steps, obs, rew, term, reason,
+            advance, rows, m.model_id, self.x, self.u, m.p, self.c, self.dt, self.a, self.u0,
+            self.B, *self._kernel_args(), self.steps, self.obs, self.rew, self.term, self.reason,
         )
 
     def step(self) -> int:
         """Step every row with the actions in ``self.a``; returns a bad action row or -1."""
         if self._step_args is None:  # built once: every array is updated in place
-            self._step_args = self._args(True, slice(None))
+            self._step_args = self._args(True, np.arange(self.n))
         return self._kernel(self.n)(*self._step_args)
 
-    def reset_row(
-        self, i: int, rng: np.random.Generator, options: Mapping[str, Any] | None = None
+    def reset_rows(
+        self,
+        rows: Sequence[int],
+        rngs: Sequence[np.random.Generator],
+        options: Mapping[str, Any] | None = None,
     ) -> None:
-        """Reset row ``i`` drawing from ``rng``, with ``options`` overriding the draws."""
+        """Reset ``rows``, row ``rows[k]`` drawing from ``rngs[k]``, ``options`` overriding draws."""
         options = {} if options is None else options
         if not isinstance(options, Mapping):
             raise ValueError(f"options must be a dict, got {type(options).__name__}")
@@ -141,6 +139,12 @@ class Task:
                 f"unknown reset option(s) {sorted(unknown)}; expected any of "
                 f"{sorted(COMMON_OPTIONS | self.task_options)}"
             )
+        for i, rng in zip(rows, rngs, strict=True):
+            self._reset_row(int(i), rng, options)
+        idx = np.asarray(rows, dtype=np.int64)
+        self._kernel(idx.size)(*self._args(False, idx))
+
+    def _reset_row(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
         # Draw everything first, in a fixed order, so options never shift the random stream.
         speed = rng.uniform(0.0, self.max_current_speed)
         direction = rng.uniform(-math.pi, math.pi)
@@ -159,7 +163,6 @@ class Task:
         self.steps[i] = 0
         self.a[i] = 0.0
         self._reset_task(i, rng, options)
-        self._kernel(1)(*self._args(False, slice(i, i + 1)))
 
     def _parse_state(self, value: Any, state: np.ndarray) -> np.ndarray:
         names = self.model.state_names
@@ -216,8 +219,8 @@ class HeadingTask(Task):
 
     kernel_name = "heading"
 
-    def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
-        return (self.ipsi, self.obs_idx, self.schedule[rows], self.hold_steps)
+    def _kernel_args(self) -> tuple[Any, ...]:
+        return (self.ipsi, self.obs_idx, self.schedule, self.hold_steps)
 
     def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
         lo, hi = np.radians(self.change_range_deg)
@@ -365,8 +368,8 @@ class RVGSpeedTask(RVGMixin, Task):
 
     kernel_name = "speed"
 
-    def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
-        return (self.schedule[rows], self.hold_steps)
+    def _kernel_args(self) -> tuple[Any, ...]:
+        return (self.schedule, self.hold_steps)
 
     def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
         x = super()._initial_state(rng)
@@ -429,9 +432,9 @@ class RVGPathTask(RVGMixin, Task):
 
     kernel_name = "path"
 
-    def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
-        return (self.tangent[rows], self.leg_length[rows], self.leg_angle[rows], self.turn[rows],
-                self.n_wp[rows], self.seg[rows], self.accept_radius, self.max_cross_track,
+    def _kernel_args(self) -> tuple[Any, ...]:
+        return (self.tangent, self.leg_length, self.leg_angle, self.turn,
+                self.n_wp, self.seg, self.accept_radius, self.max_cross_track,
                 SERVICE_SPEED)
 
     def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
@@ -534,8 +537,8 @@ class RVGTargetTask(RVGMixin, Task):
 
     kernel_name = "target"
 
-    def _kernel_args(self, rows: slice) -> tuple[Any, ...]:
-        return (self.target[rows], self.target_vel[rows], self.distance[rows], self.max_distance)
+    def _kernel_args(self) -> tuple[Any, ...]:
+        return (self.target, self.target_vel, self.distance, self.max_distance)
 
     def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
         self._add_current(i, options)
