@@ -2,7 +2,7 @@
 
 One kernel per task family, looping over the rows of a batch. The single environment calls
 it with one row and the vector environment with many, so both run the same code and the same
-physics (:func:`shipgym.models.integrate.rk4_step`). Each kernel is compiled twice from one
+physics (:func:`shipgym.models.integrate.rk4_step`, inlined). Each kernel is compiled twice from one
 source: serially for small batches and with a ``prange`` row loop for large ones
 (``PARALLEL_MIN_ROWS``); both give bit-identical results. Conventions: NED, heading
 clockwise from north, SI units and radians; ``a`` is the normalised action in [-1, 1], already
@@ -26,7 +26,7 @@ from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import rk4_step
+from shipgym.models.integrate import rk4_inline
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
@@ -61,7 +61,7 @@ def _integrate_actions(model_id, x, u, p, c, dt, a, u0, B, steps):  # noqa: ANN0
     for i in prange(x.shape[0]):
         _map_action(a, u0, B, u, i)
         steps[i] += 1
-    rk4_step(model_id, x, u, p, c, dt)
+    rk4_inline(model_id, x, u, p, c, dt)
 
 
 @row_kernel

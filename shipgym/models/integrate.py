@@ -8,9 +8,8 @@ the input and current held over the step (seed 001 eq. 2). Every user of a model
 environments, the manoeuvres and identification, integrates through these functions.
 
 ``rk4_step`` runs the four stages ship by ship on small work vectors that stay in the CPU
-cache. Batches of ``PARALLEL_MIN_ROWS`` ships or more run in a Numba ``prange`` loop over
-chunks of rows on all cores (its compiled loop is also several times faster per core than the
-plain loop); smaller batches, such as a single environment, skip the thread launch.
+cache, in chunks of rows that a ``prange`` loop spreads over all cores where the caller is
+compiled for parallel execution (``rk4_step_parallel``, the environments' large-batch kernels).
 """
 
 from __future__ import annotations
@@ -78,13 +77,8 @@ PARALLEL_MIN_ROWS = 64
 _CHUNK = 256
 
 
-@kernel
-def _rk4_serial(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
-    _rk4_rows(model_id, x, u, p, c, h, 0, x.shape[0], np.empty((5, x.shape[1])))
-
-
-@parallel_kernel
-def _rk4_parallel(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
+def _rk4_batch(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
+    """Advance ``x`` in place by one RK4 step of length ``h`` [s], chunk by chunk."""
     n, m = x.shape
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     work = np.empty((n_chunks, 5, m))
@@ -92,10 +86,10 @@ def _rk4_parallel(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
         _rk4_rows(model_id, x, u, p, c, h, k * _CHUNK, min(n, (k + 1) * _CHUNK), work[k])
 
 
-@kernel
-def rk4_step(model_id, x, u, p, c, h):  # noqa: ANN001, ANN201
-    """Advance ``x`` in place by one RK4 step of length ``h`` [s] (large batches in parallel)."""
-    if x.shape[0] >= PARALLEL_MIN_ROWS:
-        _rk4_parallel(model_id, x, u, p, c, h)
-    else:
-        _rk4_serial(model_id, x, u, p, c, h)
+#: One RK4 step of a batch, serial; the environments' kernels inline ``rk4_inline`` instead,
+#: which runs in parallel where they are compiled for large batches. (A cached kernel must not
+#: call a separately compiled parallel kernel: Numba would cache a stale pointer to it.)
+rk4_step = kernel(_rk4_batch)
+rk4_inline = row_kernel(_rk4_batch)
+#: The same step on all cores, for callers from Python with large batches.
+rk4_step_parallel = parallel_kernel(_rk4_batch)
