@@ -1,9 +1,11 @@
 """Batched task state: what each environment holds for ``n`` ships, and how it is reset.
 
 A :class:`Task` owns the arrays of a batch (states, inputs, current, setpoints, paths, targets,
-observations, rewards) and one kernel of :mod:`shipgym.envs.kernels`. Resets draw every random
-quantity of row ``i`` from that row's own generator, so the vector environment's sub-env ``i``
-seeded with ``s + i`` reproduces the single environment seeded with ``s`` exactly.
+observations, rewards) and one kernel of :mod:`shipgym.envs.kernels`. A reset of row ``i``
+draws one vector of ``n_draws`` uniform numbers from that row's own generator and maps it to
+the initial conditions with NumPy, for all rows being reset at once. The single environment is
+a batch of one, so the vector environment's sub-env ``i`` seeded with ``s + i`` reproduces the
+single environment seeded with ``s`` exactly, and autoresets of many sub-envs cost one pass.
 
 Current in ``reset(options=...)``: ``current_speed`` [m/s, >= 0] and ``current_direction``
 [rad, the direction the water moves toward, clockwise from north]. Without them the speed is
@@ -22,9 +24,10 @@ from shipgym.envs import kernels
 from shipgym.models import NOMOTO_MODEL_NAMES, ShipModel, make_model
 from shipgym.models.angles import ssa
 from shipgym.models.integrate import PARALLEL_MIN_ROWS
-from shipgym.models.rvg import IT1, IT2, IU, IV, LPP, SERVICE_SPEED
+from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
 
 COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
+_N_COMMON_DRAWS = 2
 
 
 def _finite_float(name: str, value: Any) -> float:
@@ -37,13 +40,34 @@ def _finite_float(name: str, value: Any) -> float:
     return f
 
 
-def _angles(name: str, value: Any, max_len: int) -> np.ndarray:
-    arr = np.atleast_1d(np.asarray(value, dtype=np.float64))
+def _finite_vector(name: str, value: Any, max_len: int) -> np.ndarray:
+    try:
+        arr = np.atleast_1d(np.asarray(value, dtype=np.float64))
+    except (TypeError, ValueError):
+        arr = np.array([np.nan])
     if arr.ndim != 1 or not 1 <= arr.size <= max_len or not np.all(np.isfinite(arr)):
-        raise ValueError(
-            f"option {name!r} must be 1 to {max_len} finite values, got {value!r}"
-        )
+        raise ValueError(f"option {name!r} must be 1 to {max_len} finite values, got {value!r}")
     return arr
+
+
+def _point(name: str, value: Any) -> np.ndarray:
+    try:
+        v = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        v = np.array([np.nan])
+    if v.shape != (2,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"option {name!r} must be 2 finite (north, east) values, got {value!r}")
+    return v
+
+
+def _positive(name: str, value: float) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return float(value)
+
+
+def _uniform(u: np.ndarray, low: float, high: float) -> np.ndarray:
+    return low + (high - low) * u
 
 
 class Task:
@@ -53,6 +77,8 @@ class Task:
     ----------
     n : int
         Batch size.
+    model : ShipModel
+        The vessel model.
     max_current_speed : float
         Upper end [m/s] of the current speed drawn at reset.
     """
@@ -61,9 +87,10 @@ class Task:
     act_dim: ClassVar[int]
     dt: ClassVar[float]
     max_episode_steps: ClassVar[int]
+    kernel_name: ClassVar[str]
+    n_task_draws: ClassVar[int]
     task_options: ClassVar[frozenset[str]] = frozenset()
     obs_names: ClassVar[tuple[str, ...]]
-    metric_names: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, n: int, model: ShipModel, max_current_speed: float) -> None:
         if not isinstance(n, int | np.integer) or n < 1:
@@ -89,20 +116,21 @@ class Task:
         self.B = np.zeros((model.nu, self.act_dim))
         self._step_args: tuple[Any, ...] | None = None
 
-    # --- to be provided by each task -------------------------------------------------------
+    @property
+    def n_draws(self) -> int:
+        """Uniform numbers drawn from a row's generator at each reset."""
+        return _N_COMMON_DRAWS + self.n_task_draws
+
+    # --- provided by each task ---------------------------------------------------------------
     def _kernel_args(self) -> tuple[Any, ...]:
         raise NotImplementedError
 
-    kernel_name: ClassVar[str]
-
-    def _kernel(self, n: int) -> Any:
-        serial, parallel = kernels.KERNELS[self.kernel_name]
-        return parallel if n >= PARALLEL_MIN_ROWS else serial
-
-    def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        """Initial states ``(r, nx)`` from the task's uniform draws ``(r, n_task_draws)``."""
         raise NotImplementedError
 
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        """Set the task quantities (setpoints, path, target) of ``rows``."""
         raise NotImplementedError
 
     def metrics(self, i: int) -> dict[str, Any]:
@@ -110,6 +138,10 @@ class Task:
         raise NotImplementedError
 
     # --- shared ------------------------------------------------------------------------------
+    def _kernel(self, n: int) -> Any:
+        serial, parallel = kernels.KERNELS[self.kernel_name]
+        return parallel if n >= PARALLEL_MIN_ROWS else serial
+
     def _args(self, advance: bool, rows: np.ndarray) -> tuple[Any, ...]:
         m = self.model
         return (
@@ -125,11 +157,17 @@ class Task:
 
     def reset_rows(
         self,
-        rows: Sequence[int],
+        rows: Sequence[int] | np.ndarray,
         rngs: Sequence[np.random.Generator],
         options: Mapping[str, Any] | None = None,
     ) -> None:
-        """Reset ``rows``, row ``rows[k]`` drawing from ``rngs[k]``, ``options`` overriding draws."""
+        """Reset ``rows``; row ``rows[k]`` draws from ``rngs[k]``; ``options`` override draws.
+
+        Raises
+        ------
+        ValueError
+            For an unknown option or an invalid option value; nothing is changed then.
+        """
         options = {} if options is None else options
         if not isinstance(options, Mapping):
             raise ValueError(f"options must be a dict, got {type(options).__name__}")
@@ -139,47 +177,56 @@ class Task:
                 f"unknown reset option(s) {sorted(unknown)}; expected any of "
                 f"{sorted(COMMON_OPTIONS | self.task_options)}"
             )
-        for i, rng in zip(rows, rngs, strict=True):
-            self._reset_row(int(i), rng, options)
-        idx = np.asarray(rows, dtype=np.int64)
-        self._kernel(idx.size)(*self._args(False, idx))
-
-    def _reset_row(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        # Draw everything first, in a fixed order, so options never shift the random stream.
-        speed = rng.uniform(0.0, self.max_current_speed)
-        direction = rng.uniform(-math.pi, math.pi)
-        state = self._initial_state(rng)
+        rows = np.asarray(rows, dtype=np.int64)
+        draws = np.empty((rows.size, self.n_draws))
+        for k, rng in enumerate(rngs):
+            draws[k] = rng.random(self.n_draws)
+        speed = draws[:, 0] * self.max_current_speed
+        direction = _uniform(draws[:, 1], -math.pi, math.pi)
         if "current_speed" in options:
-            speed = _finite_float("current_speed", options["current_speed"])
-            if speed < 0:
-                raise ValueError(f"option 'current_speed' must be >= 0 m/s, got {speed!r}")
+            s = _finite_float("current_speed", options["current_speed"])
+            if s < 0:
+                raise ValueError(f"option 'current_speed' must be >= 0 m/s, got {s!r}")
+            speed[:] = s
         if "current_direction" in options:
-            direction = _finite_float("current_direction", options["current_direction"])
-        self.current[i] = (speed, direction)
-        self.c[i] = (speed * math.cos(direction), speed * math.sin(direction))
+            direction[:] = _finite_float("current_direction", options["current_direction"])
+        task_draws = draws[:, _N_COMMON_DRAWS:]
+        states = self._initial_states(task_draws)
         if "initial_state" in options:
-            state = self._parse_state(options["initial_state"], state)
-        self.x[i] = state
-        self.steps[i] = 0
-        self.a[i] = 0.0
-        self._reset_task(i, rng, options)
+            states[:] = self._parse_state(options["initial_state"], states[0])
+        self._validate_task_options(options)
+        self.current[rows, 0] = speed
+        self.current[rows, 1] = direction
+        self.c[rows, 0] = speed * np.cos(direction)
+        self.c[rows, 1] = speed * np.sin(direction)
+        self.x[rows] = states
+        self.steps[rows] = 0
+        self.a[rows] = 0.0
+        self._reset_task(rows, task_draws, options)
+        self._kernel(rows.size)(*self._args(False, rows))
 
-    def _parse_state(self, value: Any, state: np.ndarray) -> np.ndarray:
+    def _validate_task_options(self, options: Mapping[str, Any]) -> None:
+        """Raise ``ValueError`` for a bad task option before anything is changed."""
+
+    def _parse_state(self, value: Any, default: np.ndarray) -> np.ndarray:
         names = self.model.state_names
         if isinstance(value, Mapping):
-            state = state.copy()
+            state = default.copy()
             for key, v in value.items():
                 if key not in names:
                     raise ValueError(f"initial_state has unknown state {key!r}; states: {names}")
                 state[names.index(key)] = _finite_float(f"initial_state[{key!r}]", v)
             return state
-        arr = np.asarray(value, dtype=np.float64)
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            arr = np.array([np.nan])
         if arr.shape != (len(names),) or not np.all(np.isfinite(arr)):
             raise ValueError(
                 f"initial_state must be a dict of named states or {len(names)} finite values "
                 f"{names}, got {value!r}"
             )
-        return arr.copy()
+        return arr
 
     def info(self, i: int) -> dict[str, Any]:
         """The ``info`` dict of row ``i``: physical state, current, task metrics."""
@@ -193,12 +240,40 @@ class Task:
         return info
 
 
-class HeadingTask(Task):
+class ScheduleMixin:
+    """Setpoints held ``setpoint_interval`` seconds each, the last one to the end."""
+
+    max_setpoints: ClassVar[int] = 8
+    dt: ClassVar[float]
+    n: int
+
+    def _setup_schedule(self, setpoint_interval: float) -> None:
+        hold = round(setpoint_interval / self.dt) if math.isfinite(setpoint_interval) else 0
+        if hold < 1:
+            raise ValueError(
+                f"setpoint_interval must be a finite time >= one step ({self.dt} s), "
+                f"got {setpoint_interval!r}"
+            )
+        self.hold_steps = int(hold)
+        self.schedule = np.zeros((self.n, self.max_setpoints))
+
+    def _set_schedule(self, rows: np.ndarray, setpoints: np.ndarray) -> None:
+        """Write ``setpoints`` (``(r, k)`` or ``(k,)``) into the schedule of ``rows``."""
+        setpoints = np.broadcast_to(setpoints, (rows.size, setpoints.shape[-1]))
+        k = setpoints.shape[1]
+        self.schedule[rows] = setpoints[:, -1:]
+        self.schedule[rows, :k] = setpoints
+
+    def current_setpoint(self, i: int, steps: int) -> float:
+        """Setpoint of row ``i`` after ``steps`` steps."""
+        return float(self.schedule[i, min(steps // self.hold_steps, self.max_setpoints - 1)])
+
+
+class HeadingTask(ScheduleMixin, Task):
     """Reach and hold heading setpoints that change every ``setpoint_interval`` seconds."""
 
+    kernel_name = "heading"
     task_options = frozenset({"setpoints"})
-    metric_names = ("heading_error", "heading_setpoint")
-    max_setpoints: ClassVar[int] = 8
     n_random_setpoints: ClassVar[int]
     change_range_deg: ClassVar[tuple[float, float]]
     obs_state_names: ClassVar[tuple[str, ...]]
@@ -206,36 +281,35 @@ class HeadingTask(Task):
     def __init__(
         self, n: int, model: ShipModel, max_current_speed: float, setpoint_interval: float
     ) -> None:
-        super().__init__(n, model, max_current_speed)
-        hold = round(setpoint_interval / self.dt)
-        if not (math.isfinite(setpoint_interval) and hold >= 1):
-            raise ValueError(
-                f"setpoint_interval must be >= one step ({self.dt} s), got {setpoint_interval!r}"
-            )
-        self.hold_steps = int(hold)
-        self.schedule = np.zeros((n, self.max_setpoints))
+        Task.__init__(self, n, model, max_current_speed)
+        self._setup_schedule(setpoint_interval)
         self.ipsi = model.index("psi")
         self.obs_idx = np.array([model.index(s) for s in self.obs_state_names], dtype=np.int64)
-
-    kernel_name = "heading"
+        self.n_task_draws = 1 + 2 * self.n_random_setpoints
 
     def _kernel_args(self) -> tuple[Any, ...]:
         return (self.ipsi, self.obs_idx, self.schedule, self.hold_steps)
 
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        lo, hi = np.radians(self.change_range_deg)
-        changes = rng.uniform(lo, hi, self.n_random_setpoints) * rng.choice(
-            [-1.0, 1.0], self.n_random_setpoints
-        )
-        setpoints = ssa(self.x[i, self.ipsi] + np.cumsum(changes))
+    def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         if "setpoints" in options:
-            setpoints = ssa(_angles("setpoints", options["setpoints"], self.max_setpoints))
-        self.schedule[i] = setpoints[-1]
-        self.schedule[i, : setpoints.size] = setpoints
+            _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
+
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        if "setpoints" in options:
+            setpoints = ssa(_finite_vector("setpoints", options["setpoints"], self.max_setpoints))
+        else:
+            k = self.n_random_setpoints
+            lo, hi = np.radians(self.change_range_deg)
+            sign = np.where(draws[:, 1 + k : 1 + 2 * k] < 0.5, -1.0, 1.0)
+            changes = _uniform(draws[:, 1 : 1 + k], lo, hi) * sign
+            setpoints = ssa(self.x[rows, self.ipsi][:, None] + np.cumsum(changes, axis=1))
+        self._set_schedule(rows, setpoints)
 
     def metrics(self, i: int) -> dict[str, Any]:
-        k = min(self.steps[i] // self.hold_steps, self.max_setpoints - 1)
-        return {"heading_error": float(self.obs[i, 0]), "heading_setpoint": float(self.schedule[i, k])}
+        return {
+            "heading_error": float(self.obs[i, 0]),
+            "heading_setpoint": self.current_setpoint(i, int(self.steps[i])),
+        }
 
 
 class NomotoHeadingTask(HeadingTask):
@@ -266,15 +340,19 @@ class NomotoHeadingTask(HeadingTask):
         self.B[0, 0] = gear.max_angle
         self.service_speed = surge.service_speed
 
-    def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
-        x = np.zeros(self.model.nx)
-        x[self.ipsi] = rng.uniform(-math.pi, math.pi)
-        x[self.model.index("U")] = self.service_speed
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        x = np.zeros((draws.shape[0], self.model.nx))
+        x[:, self.ipsi] = _uniform(draws[:, 0], -math.pi, math.pi)
+        x[:, self.model.index("U")] = self.service_speed
         return x
 
 
 class RVGMixin:
-    """Common set-up of the Gunnerus tasks: model, azimuth range, thrust, initial motion."""
+    """Common set-up of the Gunnerus tasks: model, azimuth range, thrust, initial motion.
+
+    A drawn initial state moves straight ahead through the water (``nu_r = [U, 0, 0]``), so
+    ``nu = nu_r + nu_c``; an ``initial_state`` option is taken as given.
+    """
 
     dt = 0.5
     x: np.ndarray
@@ -287,22 +365,27 @@ class RVGMixin:
         self.max_azimuth = float(max_azimuth)
         self.bollard = self.params.bollard_thrust
 
-    def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
-        """Straight ahead at the service speed through the water (current added later)."""
-        x = np.zeros(10)
-        x[2] = rng.uniform(-math.pi, math.pi)
-        x[IU] = SERVICE_SPEED
-        x[IT1] = x[IT2] = self.params.service_thrust
+    def _rvg_states(self, psi: np.ndarray, speed: float | np.ndarray, thrust: float) -> np.ndarray:
+        x = np.zeros((psi.size, 10))
+        x[:, IPSI] = psi
+        x[:, IU] = speed
+        x[:, IT1] = x[:, IT2] = thrust
         return x
 
-    def _add_current(self, i: int, options: Mapping[str, Any]) -> None:
-        """Make a drawn initial state move with the current (``nu = nu_r + nu_c``)."""
+    def _add_current(self, rows: np.ndarray, options: Mapping[str, Any]) -> None:
         if "initial_state" in options:
             return
-        psi = self.x[i, 2]
-        cn, ce = self.c[i]
-        self.x[i, IU] += cn * math.cos(psi) + ce * math.sin(psi)
-        self.x[i, IV] += -cn * math.sin(psi) + ce * math.cos(psi)
+        psi = self.x[rows, IPSI]
+        cn, ce = self.c[rows, 0], self.c[rows, 1]
+        self.x[rows, IU] += cn * np.cos(psi) + ce * np.sin(psi)
+        self.x[rows, IV] += -cn * np.sin(psi) + ce * np.cos(psi)
+
+    def _setup_two_input_actions(self) -> None:
+        """``[azimuth, thrust]`` actions: azimuth fraction of ``max_azimuth``, thrust 0..bollard."""
+        half = 0.5 * self.bollard
+        self.u0[:] = (half, half, 0.0, 0.0)  # type: ignore[attr-defined]
+        self.B[2, 0] = self.B[3, 0] = self.max_azimuth  # type: ignore[attr-defined]
+        self.B[0, 1] = self.B[1, 1] = half  # type: ignore[attr-defined]
 
 
 class RVGHeadingTask(RVGMixin, HeadingTask):
@@ -329,21 +412,25 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
         self.u0[:] = (ts, ts, 0.0, 0.0)
         self.B[2, 0] = self.B[3, 0] = self.max_azimuth
 
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        self._add_current(i, options)
-        HeadingTask._reset_task(self, i, rng, options)
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        psi = _uniform(draws[:, 0], -math.pi, math.pi)
+        return self._rvg_states(psi, SERVICE_SPEED, self.params.service_thrust)
+
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        self._add_current(rows, options)
+        HeadingTask._reset_task(self, rows, draws, options)
 
 
-class RVGSpeedTask(RVGMixin, Task):
+class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
     """Gunnerus, common pod thrust command, speed setpoints (``shipgym/RVGSpeed-v0``)."""
 
     obs_dim = 4
     act_dim = 1
     max_episode_steps = 800
+    kernel_name = "speed"
+    n_task_draws = 4
     task_options = frozenset({"setpoints"})
     obs_names = ("speed_error", "u_r", "thrust_fraction", "speed_setpoint")
-    metric_names = ("speed_error", "speed_setpoint")
-    max_setpoints = 8
     speed_range = (1.5, 6.0)
 
     def __init__(
@@ -355,53 +442,50 @@ class RVGSpeedTask(RVGMixin, Task):
     ) -> None:
         Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
         self._setup_rvg(max_azimuth)
-        hold = round(setpoint_interval / self.dt)
-        if not (math.isfinite(setpoint_interval) and hold >= 1):
-            raise ValueError(
-                f"setpoint_interval must be >= one step ({self.dt} s), got {setpoint_interval!r}"
-            )
-        self.hold_steps = int(hold)
-        self.schedule = np.zeros((n, self.max_setpoints))
+        self._setup_schedule(setpoint_interval)
         half = 0.5 * self.bollard
         self.u0[:] = (half, half, 0.0, 0.0)
         self.B[0, 0] = self.B[1, 0] = half
 
-    kernel_name = "speed"
-
     def _kernel_args(self) -> tuple[Any, ...]:
         return (self.schedule, self.hold_steps)
 
-    def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
-        x = super()._initial_state(rng)
-        x[IU] = rng.uniform(0.0, 5.0)
-        x[IT1] = x[IT2] = 0.0
-        return x
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        psi = _uniform(draws[:, 0], -math.pi, math.pi)
+        return self._rvg_states(psi, _uniform(draws[:, 1], 0.0, 5.0), 0.0)
 
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        self._add_current(i, options)
-        setpoints = rng.uniform(*self.speed_range, 2)
+    def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         if "setpoints" in options:
-            setpoints = _angles("setpoints", options["setpoints"], self.max_setpoints)
-            if np.any(setpoints < 0):
-                raise ValueError(f"option 'setpoints' must be speeds >= 0 m/s, got {setpoints}")
-        self.schedule[i] = setpoints[-1]
-        self.schedule[i, : setpoints.size] = setpoints
+            sp = _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
+            if np.any(sp < 0):
+                raise ValueError(f"option 'setpoints' must be speeds >= 0 m/s, got {sp}")
+
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        self._add_current(rows, options)
+        if "setpoints" in options:
+            setpoints = _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
+        else:
+            setpoints = _uniform(draws[:, 2:4], *self.speed_range)
+        self._set_schedule(rows, setpoints)
 
     def metrics(self, i: int) -> dict[str, Any]:
         return {"speed_error": float(self.obs[i, 0]), "speed_setpoint": float(self.obs[i, 3])}
 
 
 class RVGPathTask(RVGMixin, Task):
-    """Gunnerus following straight segments between waypoints (``shipgym/RVGPathFollowing-v0``)."""
+    """Gunnerus following straight legs between waypoints (``shipgym/RVGPathFollowing-v0``)."""
 
     obs_dim = 9
     act_dim = 2
     max_episode_steps = 1600
+    kernel_name = "path"
+    max_waypoints = 16
+    max_random_legs = 5
+    # draws: heading offset, cross-track offset, number of legs, first course, legs, turns
+    n_task_draws = 4 + 2 * max_random_legs
     task_options = frozenset({"waypoints"})
     obs_names = ("cross_track_error", "course_error", "along_track_left", "next_turn",
                  "u", "v", "r", "alpha1", "thrust_fraction")
-    metric_names = ("cross_track_error", "segment", "completed")
-    max_waypoints = 16
 
     def __init__(
         self,
@@ -413,81 +497,95 @@ class RVGPathTask(RVGMixin, Task):
     ) -> None:
         Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
         self._setup_rvg(max_azimuth)
-        for name, v in (("accept_radius", accept_radius), ("max_cross_track", max_cross_track)):
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a finite distance > 0 m, got {v!r}")
-        self.accept_radius = float(accept_radius)
-        self.max_cross_track = float(max_cross_track)
-        self.wp = np.zeros((n, self.max_waypoints, 2))
-        self.tangent = np.zeros((n, self.max_waypoints, 4))  # x_k, y_k, cos chi_k, sin chi_k
-        self.leg_length = np.zeros((n, self.max_waypoints))
-        self.leg_angle = np.zeros((n, self.max_waypoints))
-        self.turn = np.zeros((n, self.max_waypoints))
+        self.accept_radius = _positive("accept_radius", accept_radius)
+        self.max_cross_track = _positive("max_cross_track", max_cross_track)
+        w = self.max_waypoints
+        self.tangent = np.zeros((n, w, 4))  # x_k, y_k, cos chi_k, sin chi_k
+        self.leg_length = np.zeros((n, w))
+        self.leg_angle = np.zeros((n, w))
+        self.turn = np.zeros((n, w))
         self.n_wp = np.full(n, 2, dtype=np.int64)
         self.seg = np.zeros(n, dtype=np.int64)
-        half = 0.5 * self.bollard
-        self.u0[:] = (half, half, 0.0, 0.0)
-        self.B[2, 0] = self.B[3, 0] = self.max_azimuth
-        self.B[0, 1] = self.B[1, 1] = half
-
-    kernel_name = "path"
+        self._setup_two_input_actions()
 
     def _kernel_args(self) -> tuple[Any, ...]:
-        return (self.tangent, self.leg_length, self.leg_angle, self.turn,
-                self.n_wp, self.seg, self.accept_radius, self.max_cross_track,
-                SERVICE_SPEED)
+        return (self.tangent, self.leg_length, self.leg_angle, self.turn, self.n_wp, self.seg,
+                self.accept_radius, self.max_cross_track, SERVICE_SPEED)
 
-    def _initial_state(self, rng: np.random.Generator) -> np.ndarray:
-        x = super()._initial_state(rng)
-        x[2] = rng.uniform(-math.radians(30), math.radians(30))  # relative to the first leg
-        x[1] = rng.uniform(-30.0, 30.0)  # cross-track offset, rotated onto the first leg below
-        return x
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        # Placed on the path by _reset_task: psi holds the offset from the first leg's course.
+        psi = _uniform(draws[:, 0], -math.radians(30.0), math.radians(30.0))
+        return self._rvg_states(psi, SERVICE_SPEED, self.params.service_thrust)
 
-    def _random_path(self, rng: np.random.Generator) -> np.ndarray:
-        m = int(rng.integers(4, 7))
-        legs = rng.uniform(200.0, 400.0, m - 1)
-        turns = rng.uniform(-math.radians(60), math.radians(60), m - 1)
-        turns[0] = rng.uniform(-math.pi, math.pi)
-        course = np.cumsum(turns)
-        steps = np.stack((legs * np.cos(course), legs * np.sin(course)), axis=1)
-        return np.vstack((np.zeros(2), np.cumsum(steps, axis=0)))
-
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        path = self._random_path(rng)
+    def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         if "waypoints" in options:
-            path = np.asarray(options["waypoints"], dtype=np.float64)
-            if (path.ndim != 2 or path.shape[1] != 2 or not 2 <= path.shape[0] <= self.max_waypoints
-                    or not np.all(np.isfinite(path))):
-                raise ValueError(
-                    f"option 'waypoints' must be 2 to {self.max_waypoints} finite (north, east) "
-                    f"points in m, got {options['waypoints']!r}"
-                )
-            if np.any(np.hypot(*np.diff(path, axis=0).T) < 1e-6):
-                raise ValueError("option 'waypoints' has two consecutive identical waypoints")
+            self._given_path(options["waypoints"])
+
+    def _given_path(self, value: Any) -> np.ndarray:
+        try:
+            path = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            path = np.zeros((0, 2))
+        if (path.ndim != 2 or path.shape[1] != 2 or not 2 <= path.shape[0] <= self.max_waypoints
+                or not np.all(np.isfinite(path))):
+            raise ValueError(
+                f"option 'waypoints' must be 2 to {self.max_waypoints} finite (north, east) "
+                f"points in m, got {value!r}"
+            )
+        if np.any(np.hypot(*np.diff(path, axis=0).T) < 1e-6):
+            raise ValueError("option 'waypoints' has two consecutive identical waypoints")
+        return path
+
+    def _random_paths(self, draws: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Waypoints ``(r, max_random_legs + 1, 2)`` and the number used per row (4 to 6)."""
+        k = self.max_random_legs
+        n_wp = 4 + np.minimum((draws[:, 2] * 3).astype(np.int64), 2)
+        turns = _uniform(draws[:, 4 + k : 4 + 2 * k], -math.radians(60), math.radians(60))
+        turns[:, 0] = _uniform(draws[:, 3], -math.pi, math.pi)
+        course = np.cumsum(turns, axis=1)
+        legs = _uniform(draws[:, 4 : 4 + k], 200.0, 400.0)
+        path = np.zeros((draws.shape[0], k + 1, 2))
+        path[:, 1:, 0] = np.cumsum(legs * np.cos(course), axis=1)
+        path[:, 1:, 1] = np.cumsum(legs * np.sin(course), axis=1)
+        return path, n_wp
+
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        r = rows.size
+        if "waypoints" in options:
+            given = self._given_path(options["waypoints"])
+            path = np.broadcast_to(given, (r, *given.shape))
+            n_wp = np.full(r, given.shape[0], dtype=np.int64)
+        else:
+            path, n_wp = self._random_paths(draws)
+        m = path.shape[1]
+        legs = np.diff(path, axis=1)
+        angle = np.arctan2(legs[..., 1], legs[..., 0])
+        # pad every row after its last waypoint with that waypoint (legs of zero length)
+        idx = np.minimum(np.arange(m)[None, :], (n_wp - 1)[:, None])
+        path = np.take_along_axis(path, idx[..., None], axis=1)
+        last_leg = (n_wp - 2)[:, None]
+        leg_idx = np.arange(m - 1)[None, :]
+        valid = leg_idx <= last_leg
+        self.tangent[rows] = 0.0
+        self.tangent[rows, :m, :2] = path
+        self.tangent[rows, : m - 1, 2] = np.where(valid, np.cos(angle), 0.0)
+        self.tangent[rows, : m - 1, 3] = np.where(valid, np.sin(angle), 0.0)
+        self.leg_length[rows] = 0.0
+        self.leg_length[rows, : m - 1] = np.where(valid, np.hypot(legs[..., 0], legs[..., 1]), 0.0)
+        self.leg_angle[rows] = 0.0
+        self.leg_angle[rows, : m - 1] = np.where(valid, angle, 0.0)
+        self.turn[rows] = 0.0
+        if m > 2:
+            self.turn[rows, : m - 2] = np.where(valid[:, 1:], ssa(np.diff(angle, axis=1)), 0.0)
+        self.n_wp[rows] = n_wp
+        self.seg[rows] = 0
         if "initial_state" not in options:
-            chi0 = math.atan2(path[1, 1] - path[0, 1], path[1, 0] - path[0, 0])
-            offset = self.x[i, 1]
-            self.x[i, 0] = path[0, 0] - offset * math.sin(chi0)
-            self.x[i, 1] = path[0, 1] + offset * math.cos(chi0)
-            self.x[i, 2] = ssa(chi0 + self.x[i, 2])
-            self._add_current(i, options)
-        m = path.shape[0]
-        legs = np.diff(path, axis=0)
-        angle = np.arctan2(legs[:, 1], legs[:, 0])
-        self.wp[i] = path[-1]
-        self.wp[i, :m] = path
-        self.tangent[i] = 0.0
-        self.tangent[i, :m, :2] = path
-        self.tangent[i, : m - 1, 2] = np.cos(angle)
-        self.tangent[i, : m - 1, 3] = np.sin(angle)
-        self.leg_length[i] = 0.0
-        self.leg_length[i, : m - 1] = np.hypot(legs[:, 0], legs[:, 1])
-        self.leg_angle[i] = 0.0
-        self.leg_angle[i, : m - 1] = angle
-        self.turn[i] = 0.0
-        self.turn[i, : m - 2] = ssa(np.diff(angle))
-        self.n_wp[i] = m
-        self.seg[i] = 0
+            chi0 = angle[:, 0]
+            offset = _uniform(draws[:, 1], -30.0, 30.0)
+            self.x[rows, IX] = path[:, 0, 0] - offset * np.sin(chi0)
+            self.x[rows, IY] = path[:, 0, 1] + offset * np.cos(chi0)
+            self.x[rows, IPSI] = ssa(chi0 + self.x[rows, IPSI])
+            self._add_current(rows, options)
 
     def metrics(self, i: int) -> dict[str, Any]:
         return {
@@ -498,7 +596,7 @@ class RVGPathTask(RVGMixin, Task):
 
     def waypoints(self, i: int) -> np.ndarray:
         """The waypoints (north, east) [m] of row ``i``."""
-        return self.wp[i, : self.n_wp[i]].copy()
+        return self.tangent[i, : self.n_wp[i], :2].copy()
 
 
 class RVGTargetTask(RVGMixin, Task):
@@ -507,10 +605,11 @@ class RVGTargetTask(RVGMixin, Task):
     obs_dim = 10
     act_dim = 2
     max_episode_steps = 1600
+    kernel_name = "target"
+    n_task_draws = 5  # heading, target range, bearing, course, speed
     task_options = frozenset({"target_position", "target_velocity", "distance"})
     obs_names = ("target_x_body", "target_y_body", "target_vx_body", "target_vy_body",
                  "distance_error", "u", "v", "r", "alpha1", "thrust_fraction")
-    metric_names = ("distance", "distance_error")
 
     def __init__(
         self,
@@ -522,51 +621,46 @@ class RVGTargetTask(RVGMixin, Task):
     ) -> None:
         Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
         self._setup_rvg(max_azimuth)
-        for name, v in (("distance", distance), ("max_distance", max_distance)):
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a finite distance > 0 m, got {v!r}")
-        self.default_distance = float(distance)
-        self.max_distance = float(max_distance)
+        self.default_distance = _positive("distance", distance)
+        self.max_distance = _positive("max_distance", max_distance)
         self.target = np.zeros((n, 2))
         self.target_vel = np.zeros((n, 2))
-        self.distance = np.full(n, float(distance))
-        half = 0.5 * self.bollard
-        self.u0[:] = (half, half, 0.0, 0.0)
-        self.B[2, 0] = self.B[3, 0] = self.max_azimuth
-        self.B[0, 1] = self.B[1, 1] = half
-
-    kernel_name = "target"
+        self.distance = np.full(n, self.default_distance)
+        self._setup_two_input_actions()
 
     def _kernel_args(self) -> tuple[Any, ...]:
         return (self.target, self.target_vel, self.distance, self.max_distance)
 
-    def _reset_task(self, i: int, rng: np.random.Generator, options: Mapping[str, Any]) -> None:
-        self._add_current(i, options)
-        rng_range = rng.uniform(300.0, 800.0)
-        bearing = self.x[i, 2] + rng.uniform(-math.pi / 3, math.pi / 3)
-        course = rng.uniform(-math.pi, math.pi)
-        speed = rng.uniform(1.0, 3.0)
-        pos = self.x[i, :2] + rng_range * np.array([math.cos(bearing), math.sin(bearing)])
-        vel = speed * np.array([math.cos(course), math.sin(course)])
+    def _initial_states(self, draws: np.ndarray) -> np.ndarray:
+        psi = _uniform(draws[:, 0], -math.pi, math.pi)
+        return self._rvg_states(psi, SERVICE_SPEED, self.params.service_thrust)
+
+    def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         for name in ("target_position", "target_velocity"):
             if name in options:
-                v = np.asarray(options[name], dtype=np.float64)
-                if v.shape != (2,) or not np.all(np.isfinite(v)):
-                    raise ValueError(f"option {name!r} must be 2 finite (north, east) values, got {options[name]!r}")
-                if name == "target_position":
-                    pos = v
-                else:
-                    vel = v
-        d = self.default_distance
-        if "distance" in options:
-            d = _finite_float("distance", options["distance"])
-            if d <= 0:
-                raise ValueError(f"option 'distance' must be > 0 m, got {d!r}")
-        self.target[i] = pos
-        self.target_vel[i] = vel
-        self.distance[i] = d
+                _point(name, options[name])
+        if "distance" in options and _finite_float("distance", options["distance"]) <= 0:
+            raise ValueError(f"option 'distance' must be > 0 m, got {options['distance']!r}")
+
+    def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
+        self._add_current(rows, options)
+        rng_range = _uniform(draws[:, 1], 300.0, 800.0)
+        bearing = self.x[rows, IPSI] + _uniform(draws[:, 2], -math.pi / 3, math.pi / 3)
+        course = _uniform(draws[:, 3], -math.pi, math.pi)
+        speed = _uniform(draws[:, 4], 1.0, 3.0)
+        self.target[rows, 0] = self.x[rows, IX] + rng_range * np.cos(bearing)
+        self.target[rows, 1] = self.x[rows, IY] + rng_range * np.sin(bearing)
+        self.target_vel[rows, 0] = speed * np.cos(course)
+        self.target_vel[rows, 1] = speed * np.sin(course)
+        if "target_position" in options:
+            self.target[rows] = _point("target_position", options["target_position"])
+        if "target_velocity" in options:
+            self.target_vel[rows] = _point("target_velocity", options["target_velocity"])
+        self.distance[rows] = (
+            _finite_float("distance", options["distance"]) if "distance" in options
+            else self.default_distance
+        )
 
     def metrics(self, i: int) -> dict[str, Any]:
         err = float(self.obs[i, 4])
         return {"distance": err + float(self.distance[i]), "distance_error": err}
-
