@@ -38,7 +38,8 @@ class _Spaces:
     @classmethod
     def _single_spaces(cls) -> tuple[spaces.Box, spaces.Box]:
         t = cls.task_cls
-        obs = spaces.Box(-np.inf, np.inf, shape=(t.obs_dim,), dtype=np.float32)
+        bounds = np.array(t.obs_bounds, dtype=np.float32)
+        obs = spaces.Box(bounds[:, 0], bounds[:, 1], dtype=np.float32)
         act = spaces.Box(-1.0, 1.0, shape=(t.act_dim,), dtype=np.float32)
         return obs, act
 
@@ -87,10 +88,15 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         task = self.task
-        try:
-            task.a[0] = action
-        except (ValueError, TypeError) as exc:
-            raise _bad_action(action, task.act_dim, str(exc)) from None
+        if getattr(action, "shape", None) != self.action_space.shape:
+            try:
+                arr = np.asarray(action, dtype=np.float64)
+            except (ValueError, TypeError) as exc:
+                raise _bad_action(action, task.act_dim, str(exc)) from None
+            if arr.shape != self.action_space.shape:
+                raise _bad_action(action, task.act_dim, f"expected shape {self.action_space.shape}")
+            action = arr
+        task.a[0] = action
         if task.step() >= 0:
             raise _bad_action(action, task.act_dim, "it holds NaN or infinity")
         if self.render_mode == "human":
@@ -194,10 +200,17 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         task = self.task
-        try:
-            task.a[:] = actions
-        except (ValueError, TypeError) as exc:
-            raise _bad_action(actions, task.act_dim, f"expected shape ({self.num_envs}, {task.act_dim}); {exc}") from None
+        if getattr(actions, "shape", None) != task.a.shape:
+            try:
+                arr = np.asarray(actions, dtype=np.float64)
+            except (ValueError, TypeError) as exc:
+                raise _bad_action(actions, task.act_dim, str(exc)) from None
+            if arr.shape != task.a.shape:
+                raise _bad_action(
+                    actions, task.act_dim, f"expected shape {task.a.shape} for {self.num_envs} envs"
+                )
+            actions = arr
+        task.a[:] = actions
         bad = task.step()
         if bad >= 0:
             raise _bad_action(actions[bad], task.act_dim, f"sub-env {bad}'s action holds NaN or infinity")

@@ -12,8 +12,9 @@ Every task kernel returns the first row whose action is not finite (then nothing
 stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps the whole
 batch, ``False`` only computes the observations of the current state (after a reset); either
 way only the rows listed in ``rows`` get new observations, rewards and flags. It writes ``obs``, ``rew``, ``term`` and ``reason`` (0 running,
-1 numerical blow-up, 2 success, 3 failure) for every row. A row whose state is no longer finite
-after the step keeps its previous observation, gets reward 0 and terminates with reason 1.
+1 numerical blow-up, 2 success, 3 failure) for every row. Observations are clipped to the
+observation-space bounds. A row whose state is no longer finite after the step keeps its
+previous observation, gets reward 0 and terminates with reason 1.
 """
 
 from __future__ import annotations
@@ -79,6 +80,13 @@ def _begin_row(x, i, rew, term, reason):  # noqa: ANN001, ANN202
 
 
 @row_kernel
+def _clip_obs(obs, i, lo, hi):  # noqa: ANN001, ANN202
+    """Clip row ``i`` of the observations to the observation space bounds."""
+    for k in range(obs.shape[1]):
+        obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
+
+
+@row_kernel
 def _action_cost(a, i):  # noqa: ANN001, ANN202
     s = 0.0
     for k in range(a.shape[1]):
@@ -88,7 +96,7 @@ def _action_cost(a, i):  # noqa: ANN001, ANN202
 
 def _heading(  # noqa: PLR0913
     advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    ipsi, obs_idx, schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
+    ipsi, obs_idx, schedule, hold_steps, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
 ):  # noqa: ANN202
     """Heading task: hold ``schedule[i, steps[i] // hold_steps]``.
 
@@ -110,12 +118,13 @@ def _heading(  # noqa: PLR0913
             for k in range(obs_idx.shape[0]):
                 obs[i, 1 + k] = x[i, obs_idx[k]]
             rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
+            _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
 def _speed(  # noqa: PLR0913
     advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    schedule, hold_steps, steps, obs, rew, term, reason,  # noqa: ANN001
+    schedule, hold_steps, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
 ):  # noqa: ANN202
     """RVG speed task: hold the speed through the water ``u_r`` at the scheduled setpoint.
 
@@ -141,6 +150,7 @@ def _speed(  # noqa: PLR0913
             obs[i, 2] = frac
             obs[i, 3] = ud
             rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
+            _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
@@ -163,7 +173,7 @@ def path_geometry(px, py, tangent, leg_length, seg, i):  # noqa: ANN001, ANN201
 def _path(  # noqa: PLR0913
     advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
     tangent, leg_length, leg_angle, turn, n_wp, seg, accept_radius,  # noqa: ANN001
-    max_cross_track, ref_speed, steps, obs, rew, term, reason,  # noqa: ANN001
+    max_cross_track, ref_speed, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
 ):  # noqa: ANN202
     """RVG path following along straight legs between waypoints.
 
@@ -223,12 +233,13 @@ def _path(  # noqa: PLR0913
                 - 0.05 * _action_cost(a, i)
                 + bonus
             )
+            _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
 def _target(  # noqa: PLR0913
     advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    target, target_vel, distance, max_distance, steps, obs, rew, term, reason,  # noqa: ANN001
+    target, target_vel, distance, max_distance, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
 ):  # noqa: ANN202
     """RVG target tracking: close on a target moving at constant velocity and hold ``distance``.
 
@@ -275,6 +286,7 @@ def _target(  # noqa: PLR0913
                 term[i] = True
                 reason[i] = FAILURE
                 rew[i] -= 10.0
+            _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 

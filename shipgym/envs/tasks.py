@@ -91,6 +91,8 @@ class Task:
     n_task_draws: ClassVar[int]
     task_options: ClassVar[frozenset[str]] = frozenset()
     obs_names: ClassVar[tuple[str, ...]]
+    #: Observation bounds (low, high) per entry; observations are clipped to them.
+    obs_bounds: ClassVar[tuple[tuple[float, float], ...]]
 
     def __init__(self, n: int, model: ShipModel, max_current_speed: float) -> None:
         if not isinstance(n, int | np.integer) or n < 1:
@@ -115,6 +117,8 @@ class Task:
         self.u0 = np.zeros(model.nu)
         self.B = np.zeros((model.nu, self.act_dim))
         self._step_args: tuple[Any, ...] | None = None
+        bounds = np.array(self.obs_bounds, dtype=np.float64)
+        self.obs_low, self.obs_high = bounds[:, 0].copy(), bounds[:, 1].copy()
 
     @property
     def n_draws(self) -> int:
@@ -147,6 +151,7 @@ class Task:
         return (
             advance, rows, m.model_id, self.x, self.u, m.p, self.c, self.dt, self.a, self.u0,
             self.B, *self._kernel_args(), self.steps, self.obs, self.rew, self.term, self.reason,
+            self.obs_low, self.obs_high,
         )
 
     def step(self) -> int:
@@ -193,7 +198,7 @@ class Task:
         task_draws = draws[:, _N_COMMON_DRAWS:]
         states = self._initial_states(task_draws)
         if "initial_state" in options:
-            states[:] = self._parse_state(options["initial_state"], states[0])
+            self._apply_initial_state(options["initial_state"], states)
         self._validate_task_options(options)
         self.current[rows, 0] = speed
         self.current[rows, 1] = direction
@@ -208,15 +213,15 @@ class Task:
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         """Raise ``ValueError`` for a bad task option before anything is changed."""
 
-    def _parse_state(self, value: Any, default: np.ndarray) -> np.ndarray:
+    def _apply_initial_state(self, value: Any, states: np.ndarray) -> None:
+        """Override drawn ``states``: a dict sets the named states, a vector the whole state."""
         names = self.model.state_names
         if isinstance(value, Mapping):
-            state = default.copy()
             for key, v in value.items():
                 if key not in names:
                     raise ValueError(f"initial_state has unknown state {key!r}; states: {names}")
-                state[names.index(key)] = _finite_float(f"initial_state[{key!r}]", v)
-            return state
+                states[:, names.index(key)] = _finite_float(f"initial_state[{key!r}]", v)
+            return
         try:
             arr = np.asarray(value, dtype=np.float64)
         except (TypeError, ValueError):
@@ -226,7 +231,7 @@ class Task:
                 f"initial_state must be a dict of named states or {len(names)} finite values "
                 f"{names}, got {value!r}"
             )
-        return arr
+        states[:] = arr
 
     def info(self, i: int) -> dict[str, Any]:
         """The ``info`` dict of row ``i``: physical state, current, task metrics."""
@@ -323,6 +328,7 @@ class NomotoHeadingTask(HeadingTask):
     change_range_deg = (10.0, 60.0)
     obs_state_names = ("r", "delta")
     obs_names = ("heading_error", "r", "delta")
+    obs_bounds = ((-math.pi, math.pi), (-0.5, 0.5), (-math.pi / 2, math.pi / 2))
 
     def __init__(
         self,
@@ -398,6 +404,7 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
     change_range_deg = (10.0, 45.0)
     obs_state_names = ("r", "alpha1", "u", "v")
     obs_names = ("heading_error", "r", "alpha1", "u", "v")
+    obs_bounds = ((-math.pi, math.pi), (-0.5, 0.5), (-math.pi, math.pi), (-10.0, 15.0), (-10.0, 10.0))
 
     def __init__(
         self,
@@ -431,6 +438,7 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
     n_task_draws = 4
     task_options = frozenset({"setpoints"})
     obs_names = ("speed_error", "u_r", "thrust_fraction", "speed_setpoint")
+    obs_bounds = ((-25.0, 25.0), (-10.0, 15.0), (0.0, 1.0), (0.0, 15.0))
     speed_range = (1.5, 6.0)
 
     def __init__(
@@ -486,6 +494,8 @@ class RVGPathTask(RVGMixin, Task):
     task_options = frozenset({"waypoints"})
     obs_names = ("cross_track_error", "course_error", "along_track_left", "next_turn",
                  "u", "v", "r", "alpha1", "thrust_fraction")
+    obs_bounds = ((-1e4, 1e4), (-math.pi, math.pi), (-1e4, 1e4), (-math.pi, math.pi),
+                  (-10.0, 15.0), (-10.0, 10.0), (-0.5, 0.5), (-math.pi, math.pi), (0.0, 1.0))
 
     def __init__(
         self,
@@ -610,6 +620,8 @@ class RVGTargetTask(RVGMixin, Task):
     task_options = frozenset({"target_position", "target_velocity", "distance"})
     obs_names = ("target_x_body", "target_y_body", "target_vx_body", "target_vy_body",
                  "distance_error", "u", "v", "r", "alpha1", "thrust_fraction")
+    obs_bounds = ((-1e5, 1e5), (-1e5, 1e5), (-50.0, 50.0), (-50.0, 50.0), (-1e5, 1e5),
+                  (-10.0, 15.0), (-10.0, 10.0), (-0.5, 0.5), (-math.pi, math.pi), (0.0, 1.0))
 
     def __init__(
         self,

@@ -1,0 +1,358 @@
+"""Speed benchmark of the shipgym environments against Gymnasium's CartPole (``shipgym bench``).
+
+All numbers come from one process, so they share the machine state and are comparable:
+
+* **single**: time per ``env.step`` through :func:`gymnasium.make` (so with Gymnasium's
+  default wrappers) for ``CartPole-v1`` and every shipgym id, in the same loop: one fixed
+  action drawn once from the seeded action space, ``reset`` on ``terminated or truncated``,
+  warm-up steps first, then several timed repeats. Reported: best and median time per step;
+  the ratio ``env_time / cartpole_time`` uses the best repeats (lower is better).
+* **vector**: environment steps per second of the NumPy-batched vector envs,
+  ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")``, against
+  Gymnasium's ``CartPoleVectorEnv(num_envs=N)``, each stepped with one fixed batch of random
+  actions (autoreset inside the env). Ratio ``env_sps / cartpole_sps`` from the best repeats
+  (higher is better).
+
+Targets (``TARGETS``) are printed as PASS/MISS. It is a measurement, not a test: the exit code
+does not depend on them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import gymnasium as gym
+import numpy as np
+
+import shipgym
+from shipgym.envs import ENV_IDS
+
+CARTPOLE_ID = "CartPole-v1"
+CARTPOLE_VECTOR = "CartPoleVectorEnv"
+
+#: Targets: (kind, env id) -> (comparison, value). Single: time ratio, lower is better;
+#: vector: throughput ratio, higher is better.
+TARGETS: dict[tuple[str, str], tuple[str, float]] = {
+    ("single", "shipgym/NomotoHeading-v0"): ("<=", 1.0),
+    ("single", "shipgym/RVGPathFollowing-v0"): ("<=", 1.5),
+    ("vector", "shipgym/RVGPathFollowing-v0"): (">=", 0.3),
+    ("vector", "shipgym/NomotoHeading-v0"): (">=", 0.5),
+}
+
+DEFAULT_STEPS = 20_000
+DEFAULT_NUM_ENVS = 4096
+DEFAULT_REPEATS = 5
+
+
+@dataclass
+class Measurement:
+    """One benchmark line.
+
+    Attributes
+    ----------
+    kind : {"single", "vector"}
+    env_id : str
+    best, median : float
+        Single: seconds per step; vector: environment steps per second.
+    repeats : list of float
+        Every repeat (same unit).
+    ratio : float or None
+        Against CartPole (``None`` for the CartPole lines themselves).
+    target : str or None
+        E.g. ``"<= 1.0"``.
+    passed : bool or None
+    """
+
+    kind: str
+    env_id: str
+    best: float
+    median: float
+    repeats: list[float] = field(default_factory=list)
+    ratio: float | None = None
+    target: str | None = None
+    passed: bool | None = None
+
+    @property
+    def unit(self) -> str:
+        return "s/step" if self.kind == "single" else "steps/s"
+
+
+def _check_target(kind: str, env_id: str, ratio: float) -> tuple[str | None, bool | None]:
+    target = TARGETS.get((kind, env_id))
+    if target is None:
+        return None, None
+    op, value = target
+    passed = ratio <= value if op == "<=" else ratio >= value
+    return f"{op} {value}", bool(passed)
+
+
+def time_single(env_id: str, steps: int, repeats: int, warmup: int, seed: int = 0) -> list[float]:
+    """Seconds per step of ``gymnasium.make(env_id)`` for each of ``repeats`` timed loops."""
+    env = gym.make(env_id)
+    try:
+        env.action_space.seed(seed)
+        action = env.action_space.sample()
+        env.reset(seed=seed)
+        step, reset = env.step, env.reset
+
+        def loop(n: int) -> None:
+            for _ in range(n):
+                _, _, terminated, truncated, _ = step(action)
+                if terminated or truncated:
+                    reset()
+
+        loop(warmup)
+        out = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            loop(steps)
+            out.append((time.perf_counter() - t0) / steps)
+        return out
+    finally:
+        env.close()
+
+
+def _make_vector(env_id: str, num_envs: int) -> gym.vector.VectorEnv:
+    if env_id == CARTPOLE_VECTOR:
+        from gymnasium.envs.classic_control.cartpole import CartPoleVectorEnv
+
+        return CartPoleVectorEnv(num_envs=num_envs)
+    return gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point")
+
+
+def time_vector(
+    env_id: str, num_envs: int, steps: int, repeats: int, warmup: int, seed: int = 0
+) -> list[float]:
+    """Environment steps per second of a vector env for each of ``repeats`` timed loops."""
+    env = _make_vector(env_id, num_envs)
+    try:
+        env.action_space.seed(seed)
+        actions = env.action_space.sample()
+        env.reset(seed=seed)
+        step = env.step
+        for _ in range(warmup):
+            step(actions)
+        out = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                step(actions)
+            out.append(steps * num_envs / (time.perf_counter() - t0))
+        return out
+    finally:
+        env.close()
+
+
+def _fmt_value(m: Measurement) -> str:
+    if m.kind == "single":
+        return f"{m.best * 1e6:8.2f} us/step"
+    return f"{m.best / 1e6:8.3f} M steps/s"
+
+
+def run_bench(
+    steps: int = DEFAULT_STEPS,
+    num_envs: int = DEFAULT_NUM_ENVS,
+    repeats: int = DEFAULT_REPEATS,
+    vec_steps: int | None = None,
+    env_ids: tuple[str, ...] = ENV_IDS,
+    progress: TextIO | bool = True,
+) -> dict[str, Any]:
+    """Run the benchmark and return its results (the ``--json`` content).
+
+    Parameters
+    ----------
+    steps : int
+        Timed steps per repeat of the single-env loop (warm-up: a tenth of it, at least 10).
+    num_envs : int
+        Batch size of the vector envs.
+    repeats : int
+        Timed repeats per measurement.
+    vec_steps : int, optional
+        Timed batched steps per repeat of the vector loop; default ``max(5, steps // 200)``.
+    env_ids : tuple of str
+        shipgym ids to measure.
+    progress : file or bool
+        Where a line per measurement is printed as it completes: a file, ``True`` for
+        ``sys.stderr`` (the default) or ``False`` for silence.
+
+    Returns
+    -------
+    dict
+        ``config``, ``system``, ``results`` (list of measurements) and ``ratios``
+        (``{"single": {id: ratio}, "vector": {id: ratio}}``).
+    """
+    for name, value in (("steps", steps), ("num_envs", num_envs), ("repeats", repeats)):
+        if not isinstance(value, int) or value < 1:
+            raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    vec_steps = max(5, steps // 200) if vec_steps is None else vec_steps
+    if not isinstance(vec_steps, int) or vec_steps < 1:
+        raise ValueError(f"vec_steps must be an integer >= 1, got {vec_steps!r}")
+    unknown = [e for e in env_ids if e not in ENV_IDS]
+    if unknown:
+        raise ValueError(f"unknown env id(s) {unknown}; expected any of {list(ENV_IDS)}")
+    stream: TextIO | None = sys.stderr if progress is True else (progress or None)
+    warmup = max(10, steps // 10)
+    vec_warmup = max(2, vec_steps // 10)
+
+    plan: list[tuple[str, str, Callable[[], list[float]]]] = []
+    for env_id in (CARTPOLE_ID, *env_ids):
+        plan.append(("single", env_id,
+                     lambda e=env_id: time_single(e, steps, repeats, warmup)))
+    for env_id in (CARTPOLE_VECTOR, *env_ids):
+        plan.append(("vector", env_id,
+                     lambda e=env_id: time_vector(e, num_envs, vec_steps, repeats, vec_warmup)))
+
+    results: list[Measurement] = []
+    reference: dict[str, float] = {}
+    t_start = time.perf_counter()
+    for k, (kind, env_id, measure) in enumerate(plan, start=1):
+        values = measure()
+        best = min(values) if kind == "single" else max(values)
+        m = Measurement(kind, env_id, best, statistics.median(values), values)
+        if env_id in (CARTPOLE_ID, CARTPOLE_VECTOR):
+            reference[kind] = best
+        else:
+            ref = reference[kind]
+            m.ratio = best / ref
+            m.target, m.passed = _check_target(kind, env_id, m.ratio)
+        results.append(m)
+        if stream is not None:
+            extra = "" if m.ratio is None else f"  ratio {m.ratio:.3f}"
+            print(f"[{k:2d}/{len(plan)}] {kind:6s} {env_id:30s} {_fmt_value(m)}{extra}",
+                  file=stream, flush=True)
+
+    ratios: dict[str, dict[str, float]] = {"single": {}, "vector": {}}
+    for m in results:
+        if m.ratio is not None:
+            ratios[m.kind][m.env_id] = m.ratio
+    return {
+        "config": {
+            "steps": steps, "vec_steps": vec_steps, "num_envs": num_envs, "repeats": repeats,
+            "warmup": warmup, "vec_warmup": vec_warmup,
+            "single_reference": CARTPOLE_ID, "vector_reference": CARTPOLE_VECTOR,
+            "statistic": "best of the repeats (min time per step, max steps per second)",
+        },
+        "system": {
+            "shipgym": shipgym.__version__, "gymnasium": gym.__version__,
+            "numpy": np.__version__, "numba": _numba_version(),
+            "python": platform.python_version(), "platform": platform.platform(),
+            "cpu_count": os.cpu_count(), "elapsed_s": round(time.perf_counter() - t_start, 2),
+        },
+        "results": [asdict(m) for m in results],
+        "ratios": ratios,
+        "targets": {f"{kind} {env_id}": f"{op} {v}"
+                    for (kind, env_id), (op, v) in TARGETS.items()},
+    }
+
+
+def _numba_version() -> str:
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - numba is a dependency
+        return "n/a"
+    return str(numba.__version__)
+
+
+def format_table(report: dict[str, Any]) -> str:
+    """The results as a plain-text table (Markdown-compatible)."""
+    cfg = report["config"]
+    lines = [
+        f"shipgym bench: best of {cfg['repeats']} repeats; single env {cfg['steps']} steps per "
+        f"repeat via gymnasium.make; vector {cfg['num_envs']} envs x {cfg['vec_steps']} steps",
+        "",
+        "| measurement | env | best | median | ratio vs CartPole | target | result |",
+        "|---|---|---:|---:|---:|---:|---|",
+    ]
+    for r in report["results"]:
+        if r["kind"] == "single":
+            best, median = f"{r['best'] * 1e6:.2f} us/step", f"{r['median'] * 1e6:.2f} us/step"
+            what = "single env step time"
+        else:
+            best, median = f"{r['best'] / 1e6:.3f} M/s", f"{r['median'] / 1e6:.3f} M/s"
+            what = f"vector env steps/s ({cfg['num_envs']})"
+        ratio = "-" if r["ratio"] is None else f"{r['ratio']:.3f}"
+        target = r["target"] or "-"
+        result = "" if r["passed"] is None else ("PASS" if r["passed"] else "MISS")
+        lines.append(f"| {what} | {r['env_id']} | {best} | {median} | {ratio} | {target} | "
+                     f"{result} |")
+    return "\n".join(lines)
+
+
+def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
+    """Bar chart of the ratios against CartPole with the targets; writes a PNG."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    cfg = report["config"]
+    fig = Figure(figsize=(12, 5.2), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
+    titles = {
+        "single": ("single env: step time / CartPole-v1 step time\n(lower is better)",
+                   "time ratio"),
+        "vector": (f"vector env ({cfg['num_envs']} envs): steps/s / CartPoleVectorEnv steps/s"
+                   "\n(higher is better)", "throughput ratio"),
+    }
+    for ax, kind in zip(axes, ("single", "vector"), strict=True):
+        rows = [r for r in report["results"] if r["kind"] == kind and r["ratio"] is not None]
+        names = [r["env_id"].removeprefix("shipgym/") for r in rows]
+        values = [r["ratio"] for r in rows]
+        colors = ["#9a9a9a" if r["passed"] is None else ("#2a8a4a" if r["passed"] else "#b8312f")
+                  for r in rows]
+        x = np.arange(len(rows))
+        bars = ax.bar(x, values, color=colors, width=0.6, zorder=2)
+        for bar, v in zip(bars, values, strict=True):
+            ax.annotate(f"{v:.3f}" if v < 1 else f"{v:.2f}", xy=(bar.get_x() + bar.get_width() / 2, v),
+                        xytext=(0, 3), textcoords="offset points", ha="center", fontsize=9)
+        for i, r in enumerate(rows):
+            if r["target"]:
+                value = float(r["target"].split()[1])
+                ax.hlines(value, i - 0.42, i + 0.42, colors="black", linestyles="--", lw=1.6,
+                          zorder=3)
+                ax.annotate(f"target {r['target']}", xy=(i, value), xytext=(0, 4),
+                            textcoords="offset points", ha="center", fontsize=8, zorder=4,
+                            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                                  "alpha": 0.85})
+        ax.axhline(1.0, color="#555555", lw=0.8, zorder=1)
+        ax.set_xticks(x, names, rotation=20, ha="right")
+        ax.set_title(titles[kind][0], fontsize=10)
+        ax.set_ylabel(titles[kind][1])
+        ax.grid(True, axis="y", alpha=0.3, zorder=0)
+        top = max([*values, *(float(r["target"].split()[1]) for r in rows if r["target"]), 1.0])
+        ax.set_ylim(0, 1.18 * top)
+    handles = [
+        Line2D([], [], color="#2a8a4a", lw=8, label="meets target"),
+        Line2D([], [], color="#b8312f", lw=8, label="misses target"),
+        Line2D([], [], color="#9a9a9a", lw=8, label="no target"),
+        Line2D([], [], color="black", ls="--", lw=1.6, label="target"),
+        Line2D([], [], color="#555555", lw=0.8, label="parity with CartPole"),
+    ]
+    fig.legend(handles=handles, loc="outside lower center", ncols=5, fontsize=9)
+    sysinfo = report["system"]
+    fig.suptitle(
+        f"shipgym {sysinfo['shipgym']} speed vs Gymnasium CartPole (one process; "
+        f"{sysinfo['cpu_count']} CPUs, numba {sysinfo['numba']})",
+        fontsize=11,
+    )
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out)
+    return out
+
+
+def write_json(report: dict[str, Any], path: str | Path) -> Path:
+    """Write the report as JSON."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(report, indent=2) + "\n")
+    return out

@@ -1,0 +1,143 @@
+"""Tests of the ``shipgym`` command line (:mod:`shipgym.cli`) and the demo/bench behind it."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipgym.cli import SUBCOMMANDS, main
+from shipgym.demo import zigzag
+from shipgym.envs import ENV_IDS
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _is_png(path: Path) -> bool:
+    return path.is_file() and path.stat().st_size > 10_000 and path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_demo_writes_figures_and_plausible_summary(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    assert _is_png(out / "zigzag.png")
+    assert _is_png(out / "path_following.png")
+    assert str(out / "zigzag.png") in stdout and str(out / "path_following.png") in stdout
+
+    first, second = (
+        float(v) for v in re.search(
+            r"first overshoot ([-\d.]+) deg, second overshoot ([-\d.]+) deg", stdout
+        ).groups()
+    )
+    # The linear first-order Mariner model: a 20/20 first overshoot below the IMO limit of
+    # 25 deg plus margin; the second, from an established swing, is larger but bounded.
+    assert 0.0 < first < 30.0
+    assert 0.0 < second < 60.0
+    assert re.search(r"completed yes", stdout), stdout
+    mean_e = float(re.search(r"mean \|cross-track\| ([\d.]+) m", stdout).group(1))
+    assert 0.0 < mean_e < 30.0
+
+
+def test_zigzag_switches_at_the_check_heading_and_measures_the_peaks() -> None:
+    zz = zigzag("nomoto1", angle_deg=20.0, dt=0.1)
+    res = zz.result
+    psi = np.degrees(res["psi"])
+    r_max = np.degrees(np.abs(res["r"]).max())
+    for k, t_rev in enumerate(zz.reversal_times):
+        i = int(np.searchsorted(res.time, t_rev))
+        check = 20.0 if k % 2 == 0 else -20.0
+        # the pilot reverses at the first sample past the check heading
+        assert abs(psi[i] - check) <= r_max * 0.1 + 1e-9
+        assert np.sign(res["delta_c"][i]) == -np.sign(check)
+    for k, (ov, tp) in enumerate(zip(zz.overshoots_deg, zz.overshoot_times, strict=True)):
+        window = (res.time >= zz.reversal_times[k]) & (res.time <= zz.reversal_times[k + 1])
+        extreme = psi[window].max() if k % 2 == 0 else -psi[window].min()
+        assert ov == pytest.approx(extreme - 20.0)
+        # at the peak the yaw rate changes sign
+        j = int(np.searchsorted(res.time, tp))
+        assert abs(np.degrees(res["r"][j])) < 0.05
+
+
+def test_zigzag_of_the_nonlinear_bech_model_has_small_overshoots() -> None:
+    zz = zigzag("bech")
+    assert all(0.0 < ov < 30.0 for ov in zz.overshoots_deg[:2])
+
+
+def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "bench.json"
+    plot = tmp_path / "bench.png"
+    argv = ["bench", "--steps", "40", "--num-envs", "4", "--repeats", "1", "--json", str(out),
+            "--plot", str(plot)]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    report = json.loads(out.read_text())
+    for kind in ("single", "vector"):
+        assert set(report["ratios"][kind]) == set(ENV_IDS)
+        assert all(math.isfinite(v) and v > 0 for v in report["ratios"][kind].values())
+    assert report["config"]["num_envs"] == 4
+    assert _is_png(plot)
+    # a table row per measurement with PASS/MISS where there is a target
+    assert captured.out.count("| single env step time |") == len(ENV_IDS) + 1
+    assert re.search(r"NomotoHeading-v0 .*\| (PASS|MISS) \|", captured.out)
+    # progress: one line per measurement
+    assert len(re.findall(r"^\[\s*\d+/12\]", captured.err, flags=re.M)) == 12
+
+
+@pytest.mark.parametrize(
+    ("argv", "bad"),
+    [
+        (["demo", "--model", "foo"], "'foo'"),
+        (["bench", "--steps", "0"], "'0'"),
+        (["bench", "--num-envs", "many"], "'many'"),
+        (["frobnicate"], "'frobnicate'"),
+    ],
+)
+def test_bad_arguments_exit_2_with_a_message(argv: list[str], bad: str, capsys) -> None:
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "error" in err and bad in err
+    assert "Traceback" not in err
+
+
+def test_bad_output_directory_is_a_clean_error(tmp_path: Path, capsys) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    assert main(["demo", "--out", str(blocker / "sub")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("shipgym: error: ") and str(blocker / "sub") in err
+
+
+def test_envs_lists_every_id(capsys) -> None:
+    assert main(["envs"]) == 0
+    out = capsys.readouterr().out
+    for env_id in ENV_IDS:
+        assert env_id in out
+    assert re.search(r"shipgym/NomotoHeading-v0\s+1\s+3\s+1\s", out)
+    assert re.search(r"shipgym/RVGPathFollowing-v0\s+2\s+9\s+0.5\s", out)
+
+
+def test_help_and_version(capsys) -> None:
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    for name in SUBCOMMANDS:
+        assert name in out
+    assert main(["--version"]) == 0
+    assert "shipgym" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("script", ["demo.py", "bench.py"])
+def test_scripts_are_thin_wrappers(script: str) -> None:
+    proc = subprocess.run(
+        [sys.executable, str(REPO / "scripts" / script), "--help"],
+        capture_output=True, text=True, timeout=120, check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert f"usage: shipgym {script.removesuffix('.py')}" in proc.stdout
