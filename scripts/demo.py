@@ -1,4 +1,6 @@
-"""Run the shipgym demo (same as ``shipgym demo``): ``python scripts/demo.py [--out DIR] [--model M]``.
+"""Run the shipgym demo, the same as ``shipgym demo``.
+
+Usage: ``python scripts/demo.py [--out DIR] [--model M]``.
 
 The logic lives in :mod:`shipgym.demo`; this is a thin wrapper around the command line.
 """

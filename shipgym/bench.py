@@ -312,8 +312,9 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         x = np.arange(len(rows))
         bars = ax.bar(x, values, color=colors, width=0.6, zorder=2)
         for bar, v in zip(bars, values, strict=True):
-            ax.annotate(f"{v:.3f}" if v < 1 else f"{v:.2f}", xy=(bar.get_x() + bar.get_width() / 2, v),
-                        xytext=(0, 3), textcoords="offset points", ha="center", fontsize=9)
+            label = f"{v:.3f}" if v < 1 else f"{v:.2f}"
+            ax.annotate(label, xy=(bar.get_x() + bar.get_width() / 2, v), xytext=(0, 3),
+                        textcoords="offset points", ha="center", fontsize=9)
         for i, r in enumerate(rows):
             if r["target"]:
                 value = float(r["target"].split()[1])

@@ -492,7 +492,7 @@ def plot_path_following(ep: PathEpisode, path: str | Path, hull_scale: float = 2
         poly = _hull(north[i], east[i], psi[i], hull_scale * LPP, hull_scale * 9.6)
         ax.add_patch(Polygon(poly, closed=True, fc="#f2f2f2", ec=_BLUE, lw=1.0, zorder=5))
     ax.plot([], [], marker=(3, 0, 0), ls="none", mfc="#f2f2f2", mec=_BLUE,
-            label=f"ship outline ({hull_scale:g}× scale), every {step * (t[1] - t[0]):.0f} s")
+            label=f"ship outline ({hull_scale:g}x scale), every {step * (t[1] - t[0]):.0f} s")
     ax.plot(east[0], north[0], "o", color=_GREEN, ms=7, zorder=6, label="start")
     ax.plot(east[-1], north[-1], "o", color=_RED, ms=7, zorder=6, label="end")
     ax.set_aspect("equal", adjustable="datalim")
@@ -538,7 +538,7 @@ def plot_path_following(ep: PathEpisode, path: str | Path, hull_scale: float = 2
         ax_a.axhline(level, color=_GREY, lw=0.8, ls="--")
     ax_a.plot(t, alpha, color=_ORANGE, lw=1.4)
     ax_a.set_ylim(-1.2 * limit, 1.2 * limit)
-    ax_a.set_ylabel("pod azimuth α [deg]\n(+ = turn to port)")
+    ax_a.set_ylabel("pod azimuth $\\alpha$ [deg]\n(+ = turn to port)")
     ax_u.plot(t, ep["u"], color=_GREEN, lw=1.4, label="surge speed u")
     ax_u.axhline(SERVICE_SPEED, color=_GREY, lw=0.8, ls="--", label="service speed")
     ax_u.set_ylabel("surge speed\nu [m/s]")

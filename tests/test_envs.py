@@ -291,29 +291,54 @@ def test_vector_autoreset_after_truncation(env_id: str, num_envs: int) -> None:
             done = term or trunc
 
 
+@pytest.mark.parametrize("num_envs", [3, 80])
 @pytest.mark.parametrize("env_id", ENV_IDS)
-def test_vector_autoreset_after_blow_up(env_id: str) -> None:
+def test_vector_autoreset_after_blow_up(env_id: str, num_envs: int) -> None:
+    """Only the sub-envs that terminated are reset, each like ``env.reset()``."""
     seed = 5
-    venv = make_vec(env_id, 3)
-    actions = sampled_actions(venv.action_space, 4, seed=seed)
+    blown = [1, num_envs - 1]
+    venv = make_vec(env_id, num_envs)
+    actions = sampled_actions(venv.action_space, 8, seed=seed)
     venv.reset(seed=seed)
     obs_before, *_ = venv.step(actions[0])
-    venv.unwrapped.task.x[1, 3] = np.nan
+    venv.unwrapped.task.x[blown, 3] = np.nan
     obs, rew, term, trunc, info = venv.step(actions[1])
-    assert term.tolist() == [False, True, False] and not trunc.any()
-    assert REASONS[info["reason"][1]] == "numerical_blow_up"
-    assert rew[1] == 0.0
-    assert np.array_equal(obs[1], obs_before[1]) and np.all(np.isfinite(obs))
-    obs, rew, term, trunc, _ = venv.step(actions[2])
-    assert not term.any() and not trunc.any() and rew[1] == 0.0
+    assert np.flatnonzero(term).tolist() == blown and not trunc.any()
+    assert [REASONS[info["reason"][i]] for i in blown] == ["numerical_blow_up"] * 2
+    assert np.all(rew[blown] == 0.0)
+    assert np.array_equal(obs[blown], obs_before[blown]) and np.all(np.isfinite(obs))
+    later = [venv.step(a) for a in actions[2:]]
+    assert np.all(later[0][1][blown] == 0.0)
+    assert not later[0][2].any() and not later[0][3].any()
 
-    env = gym.make(env_id)
-    env.reset(seed=seed + 1)
-    env.step(actions[0][1])
-    env_obs, _ = env.reset()
-    assert np.array_equal(obs[1], env_obs)
-    obs, *_ = venv.step(actions[3])
-    assert np.array_equal(obs[1], env.step(actions[3][1])[0])
+    for i in range(num_envs):
+        env = gym.make(env_id)
+        env.reset(seed=seed + i)
+        env.step(actions[0][i])
+        if i in blown:
+            expected = [env.reset()[0]] + [env.step(a[i])[0] for a in actions[3:]]
+        else:
+            assert np.array_equal(env.step(actions[1][i])[0], obs[i])
+            expected = [env.step(a[i])[0] for a in actions[2:]]
+        assert all(np.array_equal(e, r[0][i]) for e, r in zip(expected, later, strict=True)), i
+
+
+@pytest.mark.parametrize(
+    "bad_options",
+    [{"current_speed": -1.0}, {"waypoints": [[0.0, 0.0]]}, {"initial_state": {"u": np.inf}}],
+)
+def test_rejected_reset_leaves_episode_untouched(bad_options: dict[str, Any]) -> None:
+    env, twin = gym.make(RVG_PATH), gym.make(RVG_PATH)
+    actions = sampled_actions(env.action_space, 10, seed=0)
+    env.reset(seed=3)
+    twin.reset(seed=3)
+    for a in actions[:5]:
+        env.step(a)
+        twin.step(a)
+    with pytest.raises(ValueError):
+        env.reset(options=bad_options)
+    for a in actions[5:]:
+        assert_step_equal(env.step(a), twin.step(a))
 
 
 # --------------------------------------------------------------------------------------------

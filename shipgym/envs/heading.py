@@ -33,7 +33,8 @@ class NomotoHeadingEnv(ShipEnv):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (3,), float32)``:
+    ``Box(low, high, (3,), float32)`` with bounds +-pi, +-0.5 rad/s and +-pi/2 rad; observations
+    are clipped to them:
 
     | Num | Observation | Unit |
     |-----|-------------|------|
@@ -106,7 +107,8 @@ class RVGHeadingEnv(ShipEnv):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (5,), float32)``:
+    ``Box(low, high, (5,), float32)`` with bounds +-pi, +-0.5 rad/s, +-pi, [-10, 15] m/s and
+    +-10 m/s; observations are clipped to them:
 
     | Num | Observation | Unit |
     |-----|-------------|------|

@@ -26,7 +26,8 @@ class RVGPathFollowingEnv(ShipEnv):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (9,), float32)``:
+    ``Box(low, high, (9,), float32)`` with bounds +-1e4 m, +-pi, +-1e4 m, +-pi, [-10, 15] m/s,
+    +-10 m/s, +-0.5 rad/s, +-pi and [0, 1]; observations are clipped to them:
 
     | Num | Observation | Unit |
     |-----|-------------|------|

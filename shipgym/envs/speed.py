@@ -23,7 +23,8 @@ class RVGSpeedEnv(ShipEnv):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (4,), float32)``:
+    ``Box(low, high, (4,), float32)`` with bounds +-25 m/s, [-10, 15] m/s, [0, 1] and
+    [0, 15] m/s; observations are clipped to them:
 
     | Num | Observation | Unit |
     |-----|-------------|------|

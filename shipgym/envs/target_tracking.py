@@ -24,7 +24,8 @@ class RVGTargetTrackingEnv(ShipEnv):
 
     ## Observation Space
 
-    ``Box(-inf, inf, (10,), float32)``:
+    ``Box(low, high, (10,), float32)`` with bounds +-1e5 m, +-50 m/s, +-1e5 m, [-10, 15] m/s,
+    +-10 m/s, +-0.5 rad/s, +-pi and [0, 1]; observations are clipped to them:
 
     | Num | Observation | Unit |
     |-----|-------------|------|
