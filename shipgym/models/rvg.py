@@ -218,16 +218,19 @@ def rvg_row(x, u, p, c, out):  # noqa: ANN001, ANN201
     ur = uu - uc
     vr = vv - vc
     # eq. (19)-(20), summed over both pods
-    fx = 0.0
-    fy = 0.0
-    fn = 0.0
-    for k in range(2):
-        thrust = x[IT1 + k]
-        ca = math.cos(x[IA1 + k])
-        sa = math.sin(x[IA1 + k])
-        fx += thrust * ca
-        fy += thrust * sa
-        fn += thrust * (-p[P_POD + 2 * k + 1] * ca + p[P_POD + 2 * k] * sa)
+    ca1 = math.cos(x[IA1])
+    sa1 = math.sin(x[IA1])
+    if x[IA2] == x[IA1]:  # pods turned together (the usual case): no second sin/cos
+        ca2 = ca1
+        sa2 = sa1
+    else:
+        ca2 = math.cos(x[IA2])
+        sa2 = math.sin(x[IA2])
+    t1 = x[IT1]
+    t2 = x[IT2]
+    fx = t1 * ca1 + t2 * ca2
+    fy = t1 * sa1 + t2 * sa2
+    fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (-p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2)
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
     m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
     a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
