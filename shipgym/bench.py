@@ -311,10 +311,15 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
                   for r in rows]
         x = np.arange(len(rows))
         bars = ax.bar(x, values, color=colors, width=0.6, zorder=2)
+        top = max([*values, *(float(r["target"].split()[1]) for r in rows if r["target"]), 1.0])
+        ax.set_ylim(0, 1.18 * top)
         for bar, v in zip(bars, values, strict=True):
             label = f"{v:.3f}" if v < 1 else f"{v:.2f}"
-            ax.annotate(label, xy=(bar.get_x() + bar.get_width() / 2, v), xytext=(0, 3),
-                        textcoords="offset points", ha="center", fontsize=9)
+            inside = v > 0.12 * top  # value inside the bar top; tiny bars get it above
+            ax.annotate(label, xy=(bar.get_x() + bar.get_width() / 2, v),
+                        xytext=(0, -4 if inside else 3), textcoords="offset points",
+                        ha="center", va="top" if inside else "bottom", fontsize=9,
+                        fontweight="bold", color="white" if inside else "black", zorder=4)
         for i, r in enumerate(rows):
             if r["target"]:
                 value = float(r["target"].split()[1])
@@ -329,8 +334,6 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         ax.set_title(titles[kind][0], fontsize=10)
         ax.set_ylabel(titles[kind][1])
         ax.grid(True, axis="y", alpha=0.3, zorder=0)
-        top = max([*values, *(float(r["target"].split()[1]) for r in rows if r["target"]), 1.0])
-        ax.set_ylim(0, 1.18 * top)
     handles = [
         Line2D([], [], color="#2a8a4a", lw=8, label="meets target"),
         Line2D([], [], color="#b8312f", lw=8, label="misses target"),

@@ -239,8 +239,8 @@ def plot_zigzag(zz: ZigZagResult, path: str | Path) -> Path:
     ax.plot(t[:-1], cmd, color=_ORANGE, lw=1.0, ls="--", alpha=0.8,
             label=r"rudder command $\delta_c$")
     ax.plot(t, delta, color=_ORANGE, lw=1.8, label=r"rudder angle $\delta$")
-    for tr in zz.reversal_times:
-        ax.axvline(tr, color=_GREY, lw=0.6, alpha=0.5)
+    for i, tr in enumerate(zz.reversal_times):
+        ax.axvline(tr, color=_GREY, lw=0.6, alpha=0.5, label="rudder reversal" if i == 0 else None)
 
     span = max(np.abs(psi).max(), a) * 1.0
     for k, (ov, tp) in enumerate(zip(zz.overshoots_deg, zz.overshoot_times, strict=True)):

@@ -359,6 +359,17 @@ def test_env_pickles(env_id: str, steps_before: int) -> None:
         assert_step_equal(copy.step(a), env.step(a))
 
 
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_unpickled_env_keeps_read_only_model_parameters(env_id: str) -> None:
+    """``ShipModel.p`` is read-only; a writable copy is another Numba type (a recompile)."""
+    for env in (gym.make(env_id), make_vec(env_id, 2)):
+        env.reset(seed=0)
+        assert not env.unwrapped.task.model.p.flags.writeable
+        copy = pickle.loads(pickle.dumps(env))
+        assert not copy.unwrapped.task.model.p.flags.writeable
+        assert np.array_equal(copy.unwrapped.task.model.p, env.unwrapped.task.model.p)
+
+
 @pytest.mark.parametrize("steps_before", [0, 5])
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_vector_env_pickles(env_id: str, steps_before: int) -> None:

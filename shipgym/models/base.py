@@ -107,6 +107,11 @@ class ShipModel:
         set_(self, "model_id", MODEL_NAMES.index(self.name))
         self.p.flags.writeable = False
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # Unpickled arrays come back writable; the kernels are compiled for a read-only ``p``.
+        self.__dict__.update(state)
+        self.p.flags.writeable = False
+
     @property
     def nx(self) -> int:
         """Number of states."""
