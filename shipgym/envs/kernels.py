@@ -2,9 +2,11 @@
 
 One kernel per task family, looping over the rows of a batch. The single environment calls
 it with one row and the vector environment with many, so both run the same code and the same
-physics (:func:`shipgym.models.integrate.rk4_step`, inlined). Each kernel is compiled twice from one
-source: serially for small batches and with a ``prange`` row loop for large ones
-(``PARALLEL_MIN_ROWS``); both give bit-identical results. Conventions: NED, heading
+physics (:func:`shipgym.models.integrate.rk4_row`, inlined). Each kernel loops over chunks of
+rows and, for each row, maps the action, integrates, and computes the observation, reward and
+termination while the row is in cache. Each is compiled twice from one source: serially for
+small batches and with a ``prange`` loop over chunks for large ones (``PARALLEL_MIN_ROWS``);
+both give bit-identical results. Conventions: NED, heading
 clockwise from north, SI units and radians; ``a`` is the normalised action in [-1, 1], already
 clipped, mapped to the model input by ``u = u0 + B a``.
 
@@ -27,7 +29,7 @@ from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import rk4_inline
+from shipgym.models.integrate import CHUNK, rk4_row
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
@@ -57,12 +59,12 @@ def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
         u[i, j] = acc
 
 
-def _integrate_actions(model_id, x, u, p, c, dt, a, u0, B, steps):  # noqa: ANN001, ANN202
-    """Map every row's action to inputs, count the step and advance all rows by one RK4 step."""
-    for i in prange(x.shape[0]):
-        _map_action(a, u0, B, u, i)
-        steps[i] += 1
-    rk4_inline(model_id, x, u, p, c, dt)
+@row_kernel
+def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):  # noqa: ANN001, ANN202
+    """Map row ``i``'s action to inputs, count the step and take one RK4 step."""
+    _map_action(a, u0, B, u, i)
+    steps[i] += 1
+    rk4_row(model_id, x, u, p, c, dt, i, work)
 
 
 @row_kernel
@@ -107,18 +109,22 @@ def _heading(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     n_sp = schedule.shape[1]
-    for j in prange(rows.shape[0]):
-        i = rows[j]
-        if _begin_row(x, i, rew, term, reason):
-            psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-            e = ssa_scalar(psi_d - x[i, ipsi])
-            obs[i, 0] = e
-            for k in range(obs_idx.shape[0]):
-                obs[i, 1 + k] = x[i, obs_idx[k]]
-            rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
-            _clip_obs(obs, i, obs_lo, obs_hi)
+    n_rows = rows.shape[0]
+    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
+        work = np.empty((5, x.shape[1]))
+        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
+            i = rows[j]
+            if advance:
+                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
+            if _begin_row(x, i, rew, term, reason):
+                psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                e = ssa_scalar(psi_d - x[i, ipsi])
+                obs[i, 0] = e
+                for k in range(obs_idx.shape[0]):
+                    obs[i, 1 + k] = x[i, obs_idx[k]]
+                rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
+                _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
@@ -135,22 +141,26 @@ def _speed(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     n_sp = schedule.shape[1]
     tb = p[P_TBOLL]
-    for j in prange(rows.shape[0]):
-        i = rows[j]
-        if _begin_row(x, i, rew, term, reason):
-            psi = x[i, 2]
-            ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
-            ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-            frac = x[i, 6] / tb
-            obs[i, 0] = ud - ur
-            obs[i, 1] = ur
-            obs[i, 2] = frac
-            obs[i, 3] = ud
-            rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
-            _clip_obs(obs, i, obs_lo, obs_hi)
+    n_rows = rows.shape[0]
+    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
+        work = np.empty((5, x.shape[1]))
+        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
+            i = rows[j]
+            if advance:
+                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
+            if _begin_row(x, i, rew, term, reason):
+                psi = x[i, 2]
+                ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
+                ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                frac = x[i, 6] / tb
+                obs[i, 0] = ud - ur
+                obs[i, 1] = ur
+                obs[i, 2] = frac
+                obs[i, 3] = ud
+                rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
+                _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
@@ -192,48 +202,52 @@ def _path(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     tb = p[P_TBOLL]
-    for j in prange(rows.shape[0]):
-        i = rows[j]
-        if _begin_row(x, i, rew, term, reason):
-            e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-            progress = s_before[i] - s_left
-            k = seg[i]
-            dist_end = math.hypot(
-                x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
-            )
-            bonus = 0.0
-            if dist_end < accept_radius or s_left < 0.0:
-                if k + 2 < n_wp[i]:
-                    seg[i] = k + 1
-                    e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                else:
+    n_rows = rows.shape[0]
+    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
+        work = np.empty((5, x.shape[1]))
+        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
+            i = rows[j]
+            if advance:
+                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
+            if _begin_row(x, i, rew, term, reason):
+                e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+                progress = s_before[i] - s_left
+                k = seg[i]
+                dist_end = math.hypot(
+                    x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
+                )
+                bonus = 0.0
+                if dist_end < accept_radius or s_left < 0.0:
+                    if k + 2 < n_wp[i]:
+                        seg[i] = k + 1
+                        e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+                    else:
+                        term[i] = True
+                        reason[i] = SUCCESS
+                        bonus = 10.0
+                if abs(e) > max_cross_track:
                     term[i] = True
-                    reason[i] = SUCCESS
-                    bonus = 10.0
-            if abs(e) > max_cross_track:
-                term[i] = True
-                reason[i] = FAILURE
-                bonus = -10.0
-            chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
-            obs[i, 0] = e
-            obs[i, 1] = chi_err
-            obs[i, 2] = s_left
-            obs[i, 3] = turn[i, seg[i]]
-            obs[i, 4] = x[i, 3]
-            obs[i, 5] = x[i, 4]
-            obs[i, 6] = x[i, 5]
-            obs[i, 7] = x[i, 8]
-            obs[i, 8] = x[i, 6] / tb
-            rew[i] = (
-                -min(abs(e) / 50.0, 1.0)
-                - 0.1 * abs(chi_err) / math.pi
-                + 0.5 * progress / (ref_speed * dt)
-                - 0.05 * _action_cost(a, i)
-                + bonus
-            )
-            _clip_obs(obs, i, obs_lo, obs_hi)
+                    reason[i] = FAILURE
+                    bonus = -10.0
+                chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
+                obs[i, 0] = e
+                obs[i, 1] = chi_err
+                obs[i, 2] = s_left
+                obs[i, 3] = turn[i, seg[i]]
+                obs[i, 4] = x[i, 3]
+                obs[i, 5] = x[i, 4]
+                obs[i, 6] = x[i, 5]
+                obs[i, 7] = x[i, 8]
+                obs[i, 8] = x[i, 6] / tb
+                rew[i] = (
+                    -min(abs(e) / 50.0, 1.0)
+                    - 0.1 * abs(chi_err) / math.pi
+                    + 0.5 * progress / (ref_speed * dt)
+                    - 0.05 * _action_cost(a, i)
+                    + bonus
+                )
+                _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
@@ -252,46 +266,48 @@ def _target(  # noqa: PLR0913
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-        integrate(model_id, x, u, p, c, dt, a, u0, B, steps)
     tb = p[P_TBOLL]
-    for j in prange(rows.shape[0]):
-        i = rows[j]
-        if advance:
-            target[i, 0] += target_vel[i, 0] * dt
-            target[i, 1] += target_vel[i, 1] * dt
-        if _begin_row(x, i, rew, term, reason):
-            psi = x[i, 2]
-            cs = math.cos(psi)
-            sn = math.sin(psi)
-            dn = target[i, 0] - x[i, 0]
-            de = target[i, 1] - x[i, 1]
-            vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
-            ve = sn * x[i, 3] + cs * x[i, 4]
-            rvn = target_vel[i, 0] - vn
-            rve = target_vel[i, 1] - ve
-            d = math.hypot(dn, de)
-            err = d - distance[i]
-            obs[i, 0] = cs * dn + sn * de
-            obs[i, 1] = -sn * dn + cs * de
-            obs[i, 2] = cs * rvn + sn * rve
-            obs[i, 3] = -sn * rvn + cs * rve
-            obs[i, 4] = err
-            obs[i, 5] = x[i, 3]
-            obs[i, 6] = x[i, 4]
-            obs[i, 7] = x[i, 5]
-            obs[i, 8] = x[i, 8]
-            obs[i, 9] = x[i, 6] / tb
-            rew[i] = -min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
-            if d > max_distance:
-                term[i] = True
-                reason[i] = FAILURE
-                rew[i] -= 10.0
-            _clip_obs(obs, i, obs_lo, obs_hi)
+    n_rows = rows.shape[0]
+    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
+        work = np.empty((5, x.shape[1]))
+        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
+            i = rows[j]
+            if advance:
+                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
+                target[i, 0] += target_vel[i, 0] * dt
+                target[i, 1] += target_vel[i, 1] * dt
+            if _begin_row(x, i, rew, term, reason):
+                psi = x[i, 2]
+                cs = math.cos(psi)
+                sn = math.sin(psi)
+                dn = target[i, 0] - x[i, 0]
+                de = target[i, 1] - x[i, 1]
+                vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
+                ve = sn * x[i, 3] + cs * x[i, 4]
+                rvn = target_vel[i, 0] - vn
+                rve = target_vel[i, 1] - ve
+                d = math.hypot(dn, de)
+                err = d - distance[i]
+                obs[i, 0] = cs * dn + sn * de
+                obs[i, 1] = -sn * dn + cs * de
+                obs[i, 2] = cs * rvn + sn * rve
+                obs[i, 3] = -sn * rvn + cs * rve
+                obs[i, 4] = err
+                obs[i, 5] = x[i, 3]
+                obs[i, 6] = x[i, 4]
+                obs[i, 7] = x[i, 5]
+                obs[i, 8] = x[i, 8]
+                obs[i, 9] = x[i, 6] / tb
+                rew[i] = -min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
+                if d > max_distance:
+                    term[i] = True
+                    reason[i] = FAILURE
+                    rew[i] -= 10.0
+                _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 
 
 #: (serial, parallel) compilations of each task kernel, chosen by batch size.
-integrate = row_kernel(_integrate_actions)
 KERNELS = {
     name: (kernel(func), parallel_kernel(func))
     for name, func in (("heading", _heading), ("speed", _speed), ("path", _path),

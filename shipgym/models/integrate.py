@@ -48,48 +48,48 @@ def rhs(model_id, x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def _rk4_rows(model_id, x, u, p, c, h, start, stop, work):  # noqa: ANN001, ANN202
-    """Classic RK4 over rows ``start:stop``, using ``work`` (5 x nx) as scratch."""
+def rk4_row(model_id, x, u, p, c, h, i, work):  # noqa: ANN001, ANN201
+    """Advance row ``i`` of ``x`` in place by one classic RK4 step of ``h`` [s].
+
+    ``work`` is a (5, nx) scratch array (the four slopes and the stage state).
+    """
     m = x.shape[1]
     k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
-    half = 0.5 * h
-    w = h / 6.0
-    for i in range(start, stop):
-        xi = x[i]
-        ui = u[i]
-        ci = c[i]
-        row_rhs(model_id, xi, ui, p, ci, k1)
-        for j in range(m):
-            t[j] = xi[j] + half * k1[j]
-        row_rhs(model_id, t, ui, p, ci, k2)
-        for j in range(m):
-            t[j] = xi[j] + half * k2[j]
-        row_rhs(model_id, t, ui, p, ci, k3)
-        for j in range(m):
-            t[j] = xi[j] + h * k3[j]
-        row_rhs(model_id, t, ui, p, ci, k4)
-        for j in range(m):
-            xi[j] += w * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+    xi = x[i]
+    ui = u[i]
+    ci = c[i]
+    row_rhs(model_id, xi, ui, p, ci, k1)
+    for j in range(m):
+        t[j] = xi[j] + 0.5 * h * k1[j]
+    row_rhs(model_id, t, ui, p, ci, k2)
+    for j in range(m):
+        t[j] = xi[j] + 0.5 * h * k2[j]
+    row_rhs(model_id, t, ui, p, ci, k3)
+    for j in range(m):
+        t[j] = xi[j] + h * k3[j]
+    row_rhs(model_id, t, ui, p, ci, k4)
+    for j in range(m):
+        xi[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 
 
 #: Batches at least this large are integrated on all cores.
 PARALLEL_MIN_ROWS = 64
-_CHUNK = 256
+CHUNK = 256
 
 
 def _rk4_batch(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
     """Advance ``x`` in place by one RK4 step of length ``h`` [s], chunk by chunk."""
     n, m = x.shape
-    n_chunks = (n + _CHUNK - 1) // _CHUNK
+    n_chunks = (n + CHUNK - 1) // CHUNK
     work = np.empty((n_chunks, 5, m))
     for k in prange(n_chunks):
-        _rk4_rows(model_id, x, u, p, c, h, k * _CHUNK, min(n, (k + 1) * _CHUNK), work[k])
+        for i in range(k * CHUNK, min(n, (k + 1) * CHUNK)):
+            rk4_row(model_id, x, u, p, c, h, i, work[k])
 
 
-#: One RK4 step of a batch, serial; the environments' kernels inline ``rk4_inline`` instead,
-#: which runs in parallel where they are compiled for large batches. (A cached kernel must not
-#: call a separately compiled parallel kernel: Numba would cache a stale pointer to it.)
+#: One RK4 step of a batch. (The environments' kernels call ``rk4_row`` inside their own
+#: row loops; a cached kernel must not call a separately compiled parallel kernel, since
+#: Numba would cache a stale pointer to it.)
 rk4_step = kernel(_rk4_batch)
-rk4_inline = row_kernel(_rk4_batch)
 #: The same step on all cores, for callers from Python with large batches.
 rk4_step_parallel = parallel_kernel(_rk4_batch)
