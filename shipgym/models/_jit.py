@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -64,5 +65,17 @@ def row_kernel(func: F) -> F:
 
 
 def parallel_kernel(func: F) -> F:
-    """Compile a batch kernel whose ``prange`` loops run on all cores."""
-    return _compile(func, nogil=True, parallel=True)
+    """Compile a batch kernel whose ``prange`` loops run on all cores.
+
+    The function is compiled under its own name (``<name>_parallel``): Numba's cache index is
+    keyed by the function's name and signature but not by ``parallel``, so a serial and a
+    parallel compilation of one function would otherwise overwrite and load each other.
+    """
+    clone = types.FunctionType(
+        func.__code__, func.__globals__, func.__name__ + "_parallel", func.__defaults__,
+        func.__closure__,
+    )
+    clone.__qualname__ = func.__qualname__ + "_parallel"
+    clone.__module__ = func.__module__
+    clone.__doc__ = func.__doc__
+    return _compile(clone, nogil=True, parallel=True)  # type: ignore[arg-type]
