@@ -61,10 +61,14 @@ def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
 
 @row_kernel
 def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):  # noqa: ANN001, ANN202
-    """Map row ``i``'s action to inputs, count the step and take one RK4 step."""
+    """Map row ``i``'s action to inputs, count the step and take one RK4 step.
+
+    ``work`` is a tuple of five scratch vectors for :func:`rk4_row`.
+    """
     _map_action(a, u0, B, u, i)
     steps[i] += 1
-    rk4_row(model_id, x, u, p, c, dt, i, work)
+    k1, k2, k3, k4, t = work
+    rk4_row(model_id, x, u, p, c, dt, i, k1, k2, k3, k4, t)
 
 
 @row_kernel
@@ -112,7 +116,8 @@ def _heading(  # noqa: PLR0913
     n_sp = schedule.shape[1]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = np.empty((5, x.shape[1]))
+        scratch = np.empty((5, x.shape[1]))
+        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:
@@ -145,7 +150,8 @@ def _speed(  # noqa: PLR0913
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = np.empty((5, x.shape[1]))
+        scratch = np.empty((5, x.shape[1]))
+        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:
@@ -193,11 +199,6 @@ def _path(  # noqa: PLR0913
     + 0.5 progress / (ref_speed dt) - 0.05 |a|^2``; +10 on reaching the last waypoint, -10 when
     ``|e| > max_cross_track``.
     """
-    n = x.shape[0]
-    s_before = np.empty(n)
-    for j in prange(rows.shape[0]):
-        i = rows[j]
-        s_before[i] = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
@@ -205,14 +206,16 @@ def _path(  # noqa: PLR0913
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = np.empty((5, x.shape[1]))
+        scratch = np.empty((5, x.shape[1]))
+        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
+            s_before = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
             if advance:
                 _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
             if _begin_row(x, i, rew, term, reason):
                 e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                progress = s_before[i] - s_left
+                progress = s_before - s_left
                 k = seg[i]
                 dist_end = math.hypot(
                     x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
@@ -269,7 +272,8 @@ def _target(  # noqa: PLR0913
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = np.empty((5, x.shape[1]))
+        scratch = np.empty((5, x.shape[1]))
+        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:

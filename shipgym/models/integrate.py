@@ -48,13 +48,12 @@ def rhs(model_id, x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def rk4_row(model_id, x, u, p, c, h, i, work):  # noqa: ANN001, ANN201
+def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):  # noqa: ANN001, ANN201
     """Advance row ``i`` of ``x`` in place by one classic RK4 step of ``h`` [s].
 
-    ``work`` is a (5, nx) scratch array (the four slopes and the stage state).
+    ``k1`` to ``k4`` and ``t`` are scratch vectors of length nx (the slopes and the stage state).
     """
     m = x.shape[1]
-    k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
     xi = x[i]
     ui = u[i]
     ci = c[i]
@@ -83,8 +82,10 @@ def _rk4_batch(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
     n_chunks = (n + CHUNK - 1) // CHUNK
     work = np.empty((n_chunks, 5, m))
     for k in prange(n_chunks):
+        w = work[k]
+        k1, k2, k3, k4, t = w[0], w[1], w[2], w[3], w[4]
         for i in range(k * CHUNK, min(n, (k + 1) * CHUNK)):
-            rk4_row(model_id, x, u, p, c, h, i, work[k])
+            rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
 
 
 #: One RK4 step of a batch. (The environments' kernels call ``rk4_row`` inside their own

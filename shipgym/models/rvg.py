@@ -156,7 +156,7 @@ P_MRB = 27  # m11, m22, (m23 + m32) / 2 of M_rb
 P_MA_C = 30  # a11, a22, (a23 + a32) / 2 of M_a, for C_a
 P_DQ = 33  # D_u[0,0], D_v[1,1], D_r[2,2]
 P_POD = 36  # x1, y1, x2, y2
-P_TAU_T, P_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_U0 = 40, 41, 42, 43, 44, 45
+P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = 40, 41, 42, 43, 44, 45  # 1/x saves divisions
 P_SIZE = 46
 
 
@@ -177,26 +177,26 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
         params.yaw_quadratic_damping,
     )
     p[P_POD : P_POD + 4] = (params.pod_x[0], params.pod_y[0], params.pod_x[1], params.pod_y[1])
-    p[P_TAU_T] = params.thrust_time_constant
-    p[P_TAU_A] = params.azimuth_time_constant
+    p[P_INV_TAU_T] = 1.0 / params.thrust_time_constant
+    p[P_INV_TAU_A] = 1.0 / params.azimuth_time_constant
     p[P_ARATE] = params.azimuth_max_rate
     p[P_AMAX] = params.azimuth_max
     p[P_TBOLL] = params.bollard_thrust
-    p[P_U0] = params.thrust_zero_speed
+    p[P_INV_U0] = 1.0 / params.thrust_zero_speed
     return p
 
 
 @row_kernel
 def _pod_state_rates(x, u, p, out, ur):  # noqa: ANN001, ANN202
     """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
-    tmax = p[P_TBOLL] * min(max(1.0 - ur / p[P_U0], 0.0), 1.0)
+    tmax = p[P_TBOLL] * min(max(1.0 - ur * p[P_INV_U0], 0.0), 1.0)
     amax = p[P_AMAX]
     rate = p[P_ARATE]
     for k in range(2):
         tc = min(max(u[k], 0.0), tmax)
-        out[IT1 + k] = (tc - x[IT1 + k]) / p[P_TAU_T]
+        out[IT1 + k] = (tc - x[IT1 + k]) * p[P_INV_TAU_T]
         ac = min(max(u[2 + k], -amax), amax)
-        out[IA1 + k] = min(max((ac - x[IA1 + k]) / p[P_TAU_A], -rate), rate)
+        out[IA1 + k] = min(max((ac - x[IA1 + k]) * p[P_INV_TAU_A], -rate), rate)
 
 
 @row_kernel
