@@ -205,11 +205,15 @@ def run_bench(
 
     plan: list[tuple[str, str, Callable[[], list[float]]]] = []
     for env_id in (CARTPOLE_ID, *env_ids):
-        plan.append(("single", env_id,
-                     lambda e=env_id: time_single(e, steps, repeats, warmup)))
+        plan.append(("single", env_id, lambda e=env_id: time_single(e, steps, repeats, warmup)))
     for env_id in (CARTPOLE_VECTOR, *env_ids):
-        plan.append(("vector", env_id,
-                     lambda e=env_id: time_vector(e, num_envs, vec_steps, repeats, vec_warmup)))
+        plan.append(
+            (
+                "vector",
+                env_id,
+                lambda e=env_id: time_vector(e, num_envs, vec_steps, repeats, vec_warmup),
+            )
+        )
 
     results: list[Measurement] = []
     reference: dict[str, float] = {}
@@ -227,8 +231,11 @@ def run_bench(
         results.append(m)
         if stream is not None:
             extra = "" if m.ratio is None else f"  ratio {m.ratio:.3f}"
-            print(f"[{k:2d}/{len(plan)}] {kind:6s} {env_id:30s} {_fmt_value(m)}{extra}",
-                  file=stream, flush=True)
+            print(
+                f"[{k:2d}/{len(plan)}] {kind:6s} {env_id:30s} {_fmt_value(m)}{extra}",
+                file=stream,
+                flush=True,
+            )
 
     ratios: dict[str, dict[str, float]] = {"single": {}, "vector": {}}
     for m in results:
@@ -236,21 +243,29 @@ def run_bench(
             ratios[m.kind][m.env_id] = m.ratio
     return {
         "config": {
-            "steps": steps, "vec_steps": vec_steps, "num_envs": num_envs, "repeats": repeats,
-            "warmup": warmup, "vec_warmup": vec_warmup,
-            "single_reference": CARTPOLE_ID, "vector_reference": CARTPOLE_VECTOR,
+            "steps": steps,
+            "vec_steps": vec_steps,
+            "num_envs": num_envs,
+            "repeats": repeats,
+            "warmup": warmup,
+            "vec_warmup": vec_warmup,
+            "single_reference": CARTPOLE_ID,
+            "vector_reference": CARTPOLE_VECTOR,
             "statistic": "best of the repeats (min time per step, max steps per second)",
         },
         "system": {
-            "shipgym": shipgym.__version__, "gymnasium": gym.__version__,
-            "numpy": np.__version__, "numba": _numba_version(),
-            "python": platform.python_version(), "platform": platform.platform(),
-            "cpu_count": os.cpu_count(), "elapsed_s": round(time.perf_counter() - t_start, 2),
+            "shipgym": shipgym.__version__,
+            "gymnasium": gym.__version__,
+            "numpy": np.__version__,
+            "numba": _numba_version(),
+            "python": platform.python_version(),
+            "platform": platform.platform(),
+            "cpu_count": os.cpu_count(),
+            "elapsed_s": round(time.perf_counter() - t_start, 2),
         },
         "results": [asdict(m) for m in results],
         "ratios": ratios,
-        "targets": {f"{kind} {env_id}": f"{op} {v}"
-                    for (kind, env_id), (op, v) in TARGETS.items()},
+        "targets": {f"{kind} {env_id}": f"{op} {v}" for (kind, env_id), (op, v) in TARGETS.items()},
     }
 
 
@@ -282,8 +297,9 @@ def format_table(report: dict[str, Any]) -> str:
         ratio = "-" if r["ratio"] is None else f"{r['ratio']:.3f}"
         target = r["target"] or "-"
         result = "" if r["passed"] is None else ("PASS" if r["passed"] else "MISS")
-        lines.append(f"| {what} | {r['env_id']} | {best} | {median} | {ratio} | {target} | "
-                     f"{result} |")
+        lines.append(
+            f"| {what} | {r['env_id']} | {best} | {median} | {ratio} | {target} | {result} |"
+        )
     return "\n".join(lines)
 
 
@@ -298,17 +314,24 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, 2)
     titles = {
-        "single": ("single env: step time / CartPole-v1 step time\n(lower is better)",
-                   "time ratio"),
-        "vector": (f"vector env ({cfg['num_envs']} envs): steps/s / CartPoleVectorEnv steps/s"
-                   "\n(higher is better)", "throughput ratio"),
+        "single": (
+            "single env: step time / CartPole-v1 step time\n(lower is better)",
+            "time ratio",
+        ),
+        "vector": (
+            f"vector env ({cfg['num_envs']} envs): steps/s / CartPoleVectorEnv steps/s"
+            "\n(higher is better)",
+            "throughput ratio",
+        ),
     }
     for ax, kind in zip(axes, ("single", "vector"), strict=True):
         rows = [r for r in report["results"] if r["kind"] == kind and r["ratio"] is not None]
         names = [r["env_id"].removeprefix("shipgym/") for r in rows]
         values = [r["ratio"] for r in rows]
-        colors = ["#9a9a9a" if r["passed"] is None else ("#2a8a4a" if r["passed"] else "#b8312f")
-                  for r in rows]
+        colors = [
+            "#9a9a9a" if r["passed"] is None else ("#2a8a4a" if r["passed"] else "#b8312f")
+            for r in rows
+        ]
         x = np.arange(len(rows))
         bars = ax.bar(x, values, color=colors, width=0.6, zorder=2)
         top = max([*values, *(float(r["target"].split()[1]) for r in rows if r["target"]), 1.0])
@@ -316,19 +339,34 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         for bar, v in zip(bars, values, strict=True):
             label = f"{v:.3f}" if v < 1 else f"{v:.2f}"
             inside = v > 0.12 * top  # value inside the bar top; tiny bars get it above
-            ax.annotate(label, xy=(bar.get_x() + bar.get_width() / 2, v),
-                        xytext=(0, -4 if inside else 3), textcoords="offset points",
-                        ha="center", va="top" if inside else "bottom", fontsize=9,
-                        fontweight="bold", color="white" if inside else "black", zorder=4)
+            ax.annotate(
+                label,
+                xy=(bar.get_x() + bar.get_width() / 2, v),
+                xytext=(0, -4 if inside else 3),
+                textcoords="offset points",
+                ha="center",
+                va="top" if inside else "bottom",
+                fontsize=9,
+                fontweight="bold",
+                color="white" if inside else "black",
+                zorder=4,
+            )
         for i, r in enumerate(rows):
             if r["target"]:
                 value = float(r["target"].split()[1])
-                ax.hlines(value, i - 0.42, i + 0.42, colors="black", linestyles="--", lw=1.6,
-                          zorder=3)
-                ax.annotate(f"target {r['target']}", xy=(i, value), xytext=(0, 4),
-                            textcoords="offset points", ha="center", fontsize=8, zorder=4,
-                            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
-                                  "alpha": 0.85})
+                ax.hlines(
+                    value, i - 0.42, i + 0.42, colors="black", linestyles="--", lw=1.6, zorder=3
+                )
+                ax.annotate(
+                    f"target {r['target']}",
+                    xy=(i, value),
+                    xytext=(0, 4),
+                    textcoords="offset points",
+                    ha="center",
+                    fontsize=8,
+                    zorder=4,
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85},
+                )
         ax.axhline(1.0, color="#555555", lw=0.8, zorder=1)
         ax.set_xticks(x, names, rotation=20, ha="right")
         ax.set_title(titles[kind][0], fontsize=10)

@@ -43,8 +43,9 @@ def _positive_int(text: str) -> int:
 def _run_demo(args: argparse.Namespace) -> int:
     from shipgym.demo import format_summary, run_demo
 
-    print(f"running the shipgym demo (zigzag 20/20 with {args.model}, path following) ...",
-          flush=True)
+    print(
+        f"running the shipgym demo (zigzag 20/20 with {args.model}, path following) ...", flush=True
+    )
     summary = run_demo(args.out, model=args.model)
     print(format_summary(summary))
     return 0
@@ -63,10 +64,18 @@ def _build_demo(sub: Any) -> None:
             "path_following.png and prints the overshoots and the cross-track error."
         ),
     )
-    p.add_argument("--out", default="shipgym-demo", metavar="DIR",
-                   help="output directory (default: %(default)s)")
-    p.add_argument("--model", default="nomoto1", choices=NOMOTO_MODEL_NAMES,
-                   help="Nomoto-family model of the zigzag (default: %(default)s)")
+    p.add_argument(
+        "--out",
+        default="shipgym-demo",
+        metavar="DIR",
+        help="output directory (default: %(default)s)",
+    )
+    p.add_argument(
+        "--model",
+        default="nomoto1",
+        choices=NOMOTO_MODEL_NAMES,
+        help="Nomoto-family model of the zigzag (default: %(default)s)",
+    )
     p.set_defaults(handler=_run_demo)
 
 
@@ -79,7 +88,8 @@ def _run_bench(args: argparse.Namespace) -> int:
     print(
         f"shipgym bench: single env {args.steps} steps x {args.repeats} repeats, vector "
         f"{args.num_envs} envs; one line per measurement as it completes",
-        file=sys.stderr, flush=True,
+        file=sys.stderr,
+        flush=True,
     )
     report = run_bench(
         steps=args.steps, num_envs=args.num_envs, repeats=args.repeats, vec_steps=args.vec_steps
@@ -105,17 +115,41 @@ def _build_bench(sub: Any) -> None:
             "The exit code does not depend on PASS/MISS."
         ),
     )
-    p.add_argument("--steps", type=_positive_int, default=DEFAULT_STEPS, metavar="N",
-                   help="timed single-env steps per repeat (default: %(default)s)")
-    p.add_argument("--num-envs", type=_positive_int, default=DEFAULT_NUM_ENVS, metavar="N",
-                   help="vector env batch size (default: %(default)s)")
-    p.add_argument("--repeats", type=_positive_int, default=DEFAULT_REPEATS, metavar="N",
-                   help="timed repeats per measurement, best one counts (default: %(default)s)")
-    p.add_argument("--vec-steps", type=_positive_int, default=None, metavar="N",
-                   help="timed vector steps per repeat (default: max(5, steps // 200))")
+    p.add_argument(
+        "--steps",
+        type=_positive_int,
+        default=DEFAULT_STEPS,
+        metavar="N",
+        help="timed single-env steps per repeat (default: %(default)s)",
+    )
+    p.add_argument(
+        "--num-envs",
+        type=_positive_int,
+        default=DEFAULT_NUM_ENVS,
+        metavar="N",
+        help="vector env batch size (default: %(default)s)",
+    )
+    p.add_argument(
+        "--repeats",
+        type=_positive_int,
+        default=DEFAULT_REPEATS,
+        metavar="N",
+        help="timed repeats per measurement, best one counts (default: %(default)s)",
+    )
+    p.add_argument(
+        "--vec-steps",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="timed vector steps per repeat (default: max(5, steps // 200))",
+    )
     p.add_argument("--json", default=None, metavar="OUT", help="write the numbers as JSON")
-    p.add_argument("--plot", default=None, metavar="OUT.png",
-                   help="write a bar chart of the ratios with the targets")
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="OUT.png",
+        help="write a bar chart of the ratios with the targets",
+    )
     p.set_defaults(handler=_run_bench)
 
 
@@ -134,14 +168,16 @@ def _run_envs(args: argparse.Namespace) -> int:
         try:
             steps = env.spec.max_episode_steps if env.spec else None
             dt = float(env.unwrapped.dt)
-            rows.append((
-                env_id,
-                str(env.action_space.shape[0]),
-                str(env.observation_space.shape[0]),
-                f"{dt:g}",
-                "-" if steps is None else f"{steps} ({steps * dt:g} s)",
-                tasks.get(env_id, ""),
-            ))
+            rows.append(
+                (
+                    env_id,
+                    str(env.action_space.shape[0]),
+                    str(env.observation_space.shape[0]),
+                    f"{dt:g}",
+                    "-" if steps is None else f"{steps} ({steps * dt:g} s)",
+                    tasks.get(env_id, ""),
+                )
+            )
         finally:
             env.close()
     header = ("id", "actions", "obs", "dt [s]", "max steps", "task")

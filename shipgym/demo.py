@@ -211,12 +211,19 @@ def zigzag(
         peak_times.append(float(res.time[window][j]))
     end = int(np.searchsorted(res.time, reversals[n_overshoots])) + 1
     cropped = SimulationResult(
-        res.time[: end + 1], res.states[: end + 1], res.inputs[:end],
-        res.state_names, res.input_names,
+        res.time[: end + 1],
+        res.states[: end + 1],
+        res.inputs[:end],
+        res.state_names,
+        res.input_names,
     )
     return ZigZagResult(
-        model, float(angle_deg), cropped, tuple(reversals[: n_overshoots + 1]),
-        tuple(overshoots), tuple(peak_times),
+        model,
+        float(angle_deg),
+        cropped,
+        tuple(reversals[: n_overshoots + 1]),
+        tuple(overshoots),
+        tuple(peak_times),
     )
 
 
@@ -236,8 +243,9 @@ def plot_zigzag(zz: ZigZagResult, path: str | Path) -> Path:
     for level in (a, -a):
         ax.axhline(level, color=_GREY, lw=0.8, ls=":")
     ax.plot(t, psi, color=_BLUE, lw=2.0, label=r"heading change $\psi - \psi_0$")
-    ax.plot(t[:-1], cmd, color=_ORANGE, lw=1.0, ls="--", alpha=0.8,
-            label=r"rudder command $\delta_c$")
+    ax.plot(
+        t[:-1], cmd, color=_ORANGE, lw=1.0, ls="--", alpha=0.8, label=r"rudder command $\delta_c$"
+    )
     ax.plot(t, delta, color=_ORANGE, lw=1.8, label=r"rudder angle $\delta$")
     for i, tr in enumerate(zz.reversal_times):
         ax.axvline(tr, color=_GREY, lw=0.6, alpha=0.5, label="rudder reversal" if i == 0 else None)
@@ -248,15 +256,22 @@ def plot_zigzag(zz: ZigZagResult, path: str | Path) -> Path:
         check = a if up else -a
         peak = check + ov if up else check - ov
         ax.annotate(
-            "", xy=(tp, peak), xytext=(tp, check),
+            "",
+            xy=(tp, peak),
+            xytext=(tp, check),
             arrowprops={"arrowstyle": "<->", "color": _RED, "lw": 1.3, "shrinkA": 0, "shrinkB": 0},
         )
         ax.plot([tp], [peak], "o", color=_RED, ms=4)
         ordinal = ("1st", "2nd", "3rd", "4th", "5th", "6th")[k] if k < 6 else f"{k + 1}th"
         ax.annotate(
             f"{ordinal} overshoot\n{ov:.1f}°",
-            xy=(tp, peak), xytext=(8, 6 if up else -6), textcoords="offset points",
-            ha="left", va="bottom" if up else "top", fontsize=9, color=_RED,
+            xy=(tp, peak),
+            xytext=(8, 6 if up else -6),
+            textcoords="offset points",
+            ha="left",
+            va="bottom" if up else "top",
+            fontsize=9,
+            color=_RED,
         )
     ax.set_ylim(-1.25 * span, 1.25 * span)
     ax.set_xlim(t[0], t[-1])
@@ -273,9 +288,16 @@ def plot_zigzag(zz: ZigZagResult, path: str | Path) -> Path:
     )
     # the check headings, labelled at the right edge
     for level in (a, -a):
-        ax.annotate(f"{level:+g}°", xy=(1.0, level), xycoords=("axes fraction", "data"),
-                    xytext=(3, 0), textcoords="offset points", va="center", fontsize=8,
-                    color=_GREY)
+        ax.annotate(
+            f"{level:+g}°",
+            xy=(1.0, level),
+            xycoords=("axes fraction", "data"),
+            xytext=(3, 0),
+            textcoords="offset points",
+            va="center",
+            fontsize=8,
+            color=_GREY,
+        )
     out = Path(path)
     fig.savefig(out)
     return out
@@ -436,7 +458,9 @@ def path_following_episode(
             actions[n] = action
             n += 1
             states[n], cross[n], segment[n] = (
-                info["state"], info["cross_track_error"], info["segment"]
+                info["state"],
+                info["cross_track_error"],
+                info["segment"],
             )
             total += float(reward)
             done = terminated or truncated
@@ -483,16 +507,30 @@ def plot_path_following(ep: PathEpisode, path: str | Path, hull_scale: float = 2
     ax.plot(wp[:, 1], wp[:, 0], color=_GREY, lw=1.5, ls="--", label="path", zorder=2)
     ax.plot(wp[:, 1], wp[:, 0], "s", color="black", ms=6, zorder=4, label="waypoints")
     for k, (n_, e_) in enumerate(wp):
-        ax.annotate(f"WP{k}", xy=(e_, n_), xytext=(-8, 8), textcoords="offset points",
-                    ha="right", fontsize=9, fontweight="bold",
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})
+        ax.annotate(
+            f"WP{k}",
+            xy=(e_, n_),
+            xytext=(-8, 8),
+            textcoords="offset points",
+            ha="right",
+            fontsize=9,
+            fontweight="bold",
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8},
+        )
     ax.plot(east, north, color=_BLUE, lw=2.0, label="ship track", zorder=3)
     step = max(1, len(t) // 9)
     for i in [*range(0, len(t) - 1, step), len(t) - 1]:
         poly = _hull(north[i], east[i], psi[i], hull_scale * LPP, hull_scale * 9.6)
         ax.add_patch(Polygon(poly, closed=True, fc="#f2f2f2", ec=_BLUE, lw=1.0, zorder=5))
-    ax.plot([], [], marker=(3, 0, 0), ls="none", mfc="#f2f2f2", mec=_BLUE,
-            label=f"ship outline ({hull_scale:g}x scale), every {step * (t[1] - t[0]):.0f} s")
+    ax.plot(
+        [],
+        [],
+        marker=(3, 0, 0),
+        ls="none",
+        mfc="#f2f2f2",
+        mec=_BLUE,
+        label=f"ship outline ({hull_scale:g}x scale), every {step * (t[1] - t[0]):.0f} s",
+    )
     ax.plot(east[0], north[0], "o", color=_GREEN, ms=7, zorder=6, label="start")
     ax.plot(east[-1], north[-1], "o", color=_RED, ms=7, zorder=6, label="end")
     ax.set_aspect("equal", adjustable="datalim")
@@ -504,14 +542,20 @@ def plot_path_following(ep: PathEpisode, path: str | Path, hull_scale: float = 2
     if ep.current_speed > 0:
         d = ep.current_direction
         ax.annotate(
-            "", xy=(0.10 + 0.06 * math.sin(d), 0.92 + 0.06 * math.cos(d)),
+            "",
+            xy=(0.10 + 0.06 * math.sin(d), 0.92 + 0.06 * math.cos(d)),
             xytext=(0.10 - 0.06 * math.sin(d), 0.92 - 0.06 * math.cos(d)),
             xycoords="axes fraction",
             arrowprops={"arrowstyle": "-|>", "color": _GREEN, "lw": 2.0, "mutation_scale": 15},
         )
-        ax.annotate(f"current\n{ep.current_speed:.1f} m/s toward {math.degrees(d) % 360:.0f}°",
-                    xy=(0.17, 0.92), xycoords="axes fraction", va="center", fontsize=8.5,
-                    color=_GREEN)
+        ax.annotate(
+            f"current\n{ep.current_speed:.1f} m/s toward {math.degrees(d) % 360:.0f}°",
+            xy=(0.17, 0.92),
+            xycoords="axes fraction",
+            va="center",
+            fontsize=8.5,
+            color=_GREEN,
+        )
     status = "completed" if ep.completed else f"not completed ({ep.termination_reason})"
     ax.set_title(f"R/V Gunnerus, {PATH_ENV_ID}: {status} in {t[-1]:.0f} s", fontsize=11)
 
@@ -608,14 +652,16 @@ def run_demo(out_dir: str | Path = "shipgym-demo", model: str = "nomoto1") -> di
 
 def format_summary(summary: dict[str, Any]) -> str:
     """Human-readable summary of :func:`run_demo`'s result."""
-    return "\n".join([
-        f"zigzag 20/20 ({summary['model']}): first overshoot "
-        f"{summary['first_overshoot_deg']:.1f} deg, second overshoot "
-        f"{summary['second_overshoot_deg']:.1f} deg",
-        f"path following (RVGPathFollowing-v0): completed "
-        f"{'yes' if summary['completed'] else 'no'} in {summary['episode_time_s']:.0f} s, "
-        f"mean |cross-track| {summary['mean_abs_cross_track_m']:.1f} m "
-        f"(max {summary['max_abs_cross_track_m']:.1f} m)",
-        f"wrote {summary['zigzag_png']}",
-        f"wrote {summary['path_following_png']}",
-    ])
+    return "\n".join(
+        [
+            f"zigzag 20/20 ({summary['model']}): first overshoot "
+            f"{summary['first_overshoot_deg']:.1f} deg, second overshoot "
+            f"{summary['second_overshoot_deg']:.1f} deg",
+            f"path following (RVGPathFollowing-v0): completed "
+            f"{'yes' if summary['completed'] else 'no'} in {summary['episode_time_s']:.0f} s, "
+            f"mean |cross-track| {summary['mean_abs_cross_track_m']:.1f} m "
+            f"(max {summary['max_abs_cross_track_m']:.1f} m)",
+            f"wrote {summary['zigzag_png']}",
+            f"wrote {summary['path_following_png']}",
+        ]
+    )

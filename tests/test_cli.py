@@ -33,7 +33,8 @@ def test_demo_writes_figures_and_plausible_summary(tmp_path: Path, capsys) -> No
     assert str(out / "zigzag.png") in stdout and str(out / "path_following.png") in stdout
 
     first, second = (
-        float(v) for v in re.search(
+        float(v)
+        for v in re.search(
             r"first overshoot ([-\d.]+) deg, second overshoot ([-\d.]+) deg", stdout
         ).groups()
     )
@@ -74,8 +75,19 @@ def test_zigzag_of_the_nonlinear_bech_model_has_small_overshoots() -> None:
 def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
     out = tmp_path / "bench.json"
     plot = tmp_path / "bench.png"
-    argv = ["bench", "--steps", "40", "--num-envs", "4", "--repeats", "1", "--json", str(out),
-            "--plot", str(plot)]
+    argv = [
+        "bench",
+        "--steps",
+        "40",
+        "--num-envs",
+        "4",
+        "--repeats",
+        "1",
+        "--json",
+        str(out),
+        "--plot",
+        str(plot),
+    ]
     assert main(argv) == 0
     captured = capsys.readouterr()
     report = json.loads(out.read_text())
@@ -137,7 +149,10 @@ def test_help_and_version(capsys) -> None:
 def test_scripts_are_thin_wrappers(script: str) -> None:
     proc = subprocess.run(
         [sys.executable, str(REPO / "scripts" / script), "--help"],
-        capture_output=True, text=True, timeout=120, check=False,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
     )
     assert proc.returncode == 0, proc.stderr
     assert f"usage: shipgym {script.removesuffix('.py')}" in proc.stdout

@@ -233,8 +233,14 @@ def test_vector_env_matches_single_envs(env_id: str, num_envs: int) -> None:
 @pytest.mark.parametrize(
     ("env_id", "options"),
     [
-        (RVG_PATH, {"waypoints": [[0.0, 0.0], [200.0, 100.0], [0.0, 400.0]],
-                    "current_speed": 0.2, "current_direction": 1.0}),
+        (
+            RVG_PATH,
+            {
+                "waypoints": [[0.0, 0.0], [200.0, 100.0], [0.0, 400.0]],
+                "current_speed": 0.2,
+                "current_direction": 1.0,
+            },
+        ),
         (NOMOTO, {"setpoints": [1.0, 2.0], "initial_state": {"r": 0.01}}),
         (RVG_TARGET, {"target_position": [300.0, 0.0], "distance": 80.0}),
     ],
@@ -414,10 +420,14 @@ def test_rvg_at_rest_in_water_drifts_with_current(env_id: str, direction: float)
     speed, psi, steps = 0.4, 1.0, 200
     uc, vc = body_current(speed, direction, psi)
     env = gym.make(env_id)
-    _, info = env.reset(seed=0, options={
-        "current_speed": speed, "current_direction": direction,
-        "initial_state": rvg_state(psi=psi, u=uc, v=vc),
-    })
+    _, info = env.reset(
+        seed=0,
+        options={
+            "current_speed": speed,
+            "current_direction": direction,
+            "initial_state": rvg_state(psi=psi, u=uc, v=vc),
+        },
+    )
     action = np.array(ZERO_THRUST[env_id], dtype=np.float32)
     for _ in range(steps):
         _, _, term, _, info = env.step(action)
@@ -436,18 +446,24 @@ def test_rvg_at_rest_over_ground_is_carried_by_current(direction: float) -> None
     """A ship with u = v = r = 0 and no thrust is picked up by the current."""
     speed = 0.4
     env = gym.make(RVG_SPEED, max_episode_steps=3000)
-    env.reset(seed=0, options={
-        "current_speed": speed, "current_direction": direction,
-        "initial_state": rvg_state(psi=1.0),
-    })
+    env.reset(
+        seed=0,
+        options={
+            "current_speed": speed,
+            "current_direction": direction,
+            "initial_state": rvg_state(psi=1.0),
+        },
+    )
     for _ in range(2000):
         _, _, term, _, info = env.step(np.array([-1.0], dtype=np.float32))
         assert not term
     x, y, psi, u, v = info["state"][:5]
     v_north = u * math.cos(psi) - v * math.sin(psi)
     v_east = u * math.sin(psi) + v * math.cos(psi)
-    assert math.hypot(v_north - speed * math.cos(direction),
-                      v_east - speed * math.sin(direction)) < 0.1
+    assert (
+        math.hypot(v_north - speed * math.cos(direction), v_east - speed * math.sin(direction))
+        < 0.1
+    )
     assert math.hypot(x, y) > 200.0
     assert abs(ssa(math.atan2(y, x) - direction)) < 0.4
 
@@ -524,8 +540,9 @@ def test_heading_action_turns_documented_way(env_id: str, rudder: float, sign: i
 def test_speed_setpoints_option() -> None:
     env = gym.make(RVG_SPEED, setpoint_interval=5.0)
     hold = round(5.0 / env.unwrapped.dt)
-    obs, info = env.reset(seed=1, options={"setpoints": [2.0, 3.5], "current_speed": 0.3,
-                                           "current_direction": 0.7})
+    obs, info = env.reset(
+        seed=1, options={"setpoints": [2.0, 3.5], "current_speed": 0.3, "current_direction": 0.7}
+    )
     for k in range(3 * hold):
         if k:
             obs, _, _, _, info = env.step(np.array([0.2], dtype=np.float32))
@@ -542,10 +559,14 @@ def test_speed_setpoints_option() -> None:
 def test_waypoints_option_sets_path() -> None:
     path = [[0.0, 0.0], [300.0, 0.0], [300.0, 300.0]]
     env = gym.make(RVG_PATH)
-    obs, info = env.reset(seed=0, options={
-        "waypoints": path, "current_speed": 0.0,
-        "initial_state": rvg_state(y=20.0, u=SERVICE_SPEED, T1=25e3, T2=25e3),
-    })
+    obs, info = env.reset(
+        seed=0,
+        options={
+            "waypoints": path,
+            "current_speed": 0.0,
+            "initial_state": rvg_state(y=20.0, u=SERVICE_SPEED, T1=25e3, T2=25e3),
+        },
+    )
     assert np.array_equal(env.unwrapped.task.waypoints(0), np.array(path))
     # Ship 20 m east of a northbound leg: right of the path, positive cross-track error.
     assert info["cross_track_error"] == pytest.approx(20.0)
@@ -577,8 +598,14 @@ def test_waypoints_default_start_near_first_waypoint() -> None:
 def test_path_completion_and_failure() -> None:
     env = gym.make(RVG_PATH)
     start = rvg_state(u=SERVICE_SPEED, T1=25e3, T2=25e3)
-    env.reset(seed=0, options={"waypoints": [[0.0, 0.0], [150.0, 0.0]], "current_speed": 0.0,
-                               "initial_state": start})
+    env.reset(
+        seed=0,
+        options={
+            "waypoints": [[0.0, 0.0], [150.0, 0.0]],
+            "current_speed": 0.0,
+            "initial_state": start,
+        },
+    )
     for _ in range(100):
         _, rew, term, trunc, info = env.step(np.array([0.0, 0.0], dtype=np.float32))
         if term:
@@ -586,8 +613,14 @@ def test_path_completion_and_failure() -> None:
     assert term and not trunc
     assert info["completed"] is True and info["termination_reason"] == "success"
     assert rew > 5.0
-    env.reset(seed=0, options={"waypoints": [[0.0, 0.0], [500.0, 0.0]], "current_speed": 0.0,
-                               "initial_state": {**start, "y": 300.0}})
+    env.reset(
+        seed=0,
+        options={
+            "waypoints": [[0.0, 0.0], [500.0, 0.0]],
+            "current_speed": 0.0,
+            "initial_state": {**start, "y": 300.0},
+        },
+    )
     _, rew, term, _, info = env.step(np.array([0.0, 0.0], dtype=np.float32))
     assert term and info["termination_reason"] == "failure" and info["completed"] is False
     assert rew < -5.0
@@ -596,10 +629,16 @@ def test_path_completion_and_failure() -> None:
 def test_target_options() -> None:
     env = gym.make(RVG_TARGET)
     pos, vel = np.array([120.0, 50.0]), np.array([1.0, -0.5])
-    obs, info = env.reset(seed=0, options={
-        "target_position": pos.tolist(), "target_velocity": vel.tolist(), "distance": 30.0,
-        "current_speed": 0.0, "initial_state": rvg_state(u=SERVICE_SPEED, T1=25e3, T2=25e3),
-    })
+    obs, info = env.reset(
+        seed=0,
+        options={
+            "target_position": pos.tolist(),
+            "target_velocity": vel.tolist(),
+            "distance": 30.0,
+            "current_speed": 0.0,
+            "initial_state": rvg_state(u=SERVICE_SPEED, T1=25e3, T2=25e3),
+        },
+    )
     assert info["distance"] == pytest.approx(130.0)
     assert info["distance_error"] == pytest.approx(100.0)
     assert obs[:2] == pytest.approx([120.0, 50.0])  # heading north: body = NED axes
@@ -680,8 +719,10 @@ def test_vector_wrong_action_shape_raises(env_id: str, which: str) -> None:
 def test_out_of_range_actions_are_clipped(env_id: str) -> None:
     env_raw, env_clip = gym.make(env_id), gym.make(env_id)
     rng = np.random.default_rng(0)
-    raw = [rng.uniform(-5.0, 5.0, env_raw.action_space.shape).astype(np.float32)
-           for _ in range(N_STEPS)]
+    raw = [
+        rng.uniform(-5.0, 5.0, env_raw.action_space.shape).astype(np.float32)
+        for _ in range(N_STEPS)
+    ]
     raw[0][:] = 5.0
     raw[1][:] = -7.0
     clipped = [np.clip(a, -1.0, 1.0) for a in raw]

@@ -10,7 +10,6 @@ the physics exists once. Sub-env ``i`` of a vector env reset with seed ``s`` dra
 
 from __future__ import annotations
 
-import math
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -121,12 +120,16 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
         task = self.task
         if self._renderer is None:
             length, beam = self.ship_dimensions
-            self._renderer = TopDownRenderer(length, beam, self.render_mode, title=type(self).__name__)
+            self._renderer = TopDownRenderer(
+                length, beam, self.render_mode, title=type(self).__name__
+            )
         x = task.x[0]
         self._trail.append((float(x[0]), float(x[1])))
         steps = int(task.steps[0])
         return self._renderer.draw(
-            float(x[0]), float(x[1]), float(x[task.model.index("psi")]),
+            float(x[0]),
+            float(x[1]),
+            float(x[task.model.index("psi")]),
             trail=np.asarray(self._trail),
             current_speed=float(task.current[0, 0]),
             current_direction=float(task.current[0, 1]),
@@ -170,11 +173,14 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.num_envs = int(num_envs)
         steps = self.task.max_episode_steps if max_episode_steps is None else max_episode_steps
         if not isinstance(steps, int | np.integer) or steps < 1:
-            raise ValueError(f"max_episode_steps must be an integer >= 1, got {max_episode_steps!r}")
+            raise ValueError(
+                f"max_episode_steps must be an integer >= 1, got {max_episode_steps!r}"
+            )
         self.max_episode_steps = int(steps)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
             )
         self.render_mode = render_mode
         self.single_observation_space, self.single_action_space = self._single_spaces()
@@ -188,7 +194,11 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is not None:
-            seeds = list(seed) if isinstance(seed, list | tuple) else [seed + i for i in range(self.num_envs)]
+            seeds = (
+                list(seed)
+                if isinstance(seed, list | tuple)
+                else [seed + i for i in range(self.num_envs)]
+            )
             if len(seeds) != self.num_envs:
                 raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
@@ -213,7 +223,9 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         task.a[:] = actions
         bad = task.step()
         if bad >= 0:
-            raise _bad_action(actions[bad], task.act_dim, f"sub-env {bad}'s action holds NaN or infinity")
+            raise _bad_action(
+                actions[bad], task.act_dim, f"sub-env {bad}'s action holds NaN or infinity"
+            )
         terminated = task.term.copy()
         truncated = task.steps >= self.max_episode_steps
         rewards = task.rew.copy()
@@ -224,7 +236,13 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             terminated[self._prev_done] = False
             truncated[self._prev_done] = False
         self._prev_done = terminated | truncated
-        return task.obs.astype(np.float32), rewards, terminated, truncated, {"reason": task.reason.copy()}
+        return (
+            task.obs.astype(np.float32),
+            rewards,
+            terminated,
+            truncated,
+            {"reason": task.reason.copy()},
+        )
 
     def render(self) -> np.ndarray | None:
         """Top-down view of sub-env 0 (``rgb_array`` only)."""

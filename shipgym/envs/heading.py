@@ -1,13 +1,13 @@
 """Heading environments: ``shipgym/NomotoHeading-v0`` and ``shipgym/RVGHeading-v0``.
 
 Physics: :mod:`shipgym.models.nomoto` (seed 004 eq. 1-4, seed 002 eq. 1-3) and
-:mod:`shipgym.models.rvg` (seed 001 eq. 5-20); task logic: :func:`shipgym.envs.kernels.heading_kernel`.
+:mod:`shipgym.models.rvg` (seed 001 eq. 5-20); task logic: the ``heading`` kernel of
+:mod:`shipgym.envs.kernels`.
 """
 
 from __future__ import annotations
 
 from typing import Any
-
 
 from shipgym.envs.core import ShipEnv, ShipVectorEnv
 from shipgym.envs.tasks import NomotoHeadingTask, RVGHeadingTask

@@ -6,15 +6,15 @@ physics (:func:`shipgym.models.integrate.rk4_row`, inlined). Each kernel loops o
 rows and, for each row, maps the action, integrates, and computes the observation, reward and
 termination while the row is in cache. Each is compiled twice from one source: serially for
 small batches and with a ``prange`` loop over chunks for large ones (``PARALLEL_MIN_ROWS``);
-both give bit-identical results. Conventions: NED, heading
-clockwise from north, SI units and radians; ``a`` is the normalised action in [-1, 1], already
-clipped, mapped to the model input by ``u = u0 + B a``.
+both give bit-identical results. Conventions: NED, heading clockwise from north, SI units and
+radians; the normalised action ``a`` is clipped to [-1, 1] and mapped to the model input by
+``u = u0 + B a``.
 
 Every task kernel returns the first row whose action is not finite (then nothing was
 stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps the whole
 batch, ``False`` only computes the observations of the current state (after a reset); either
-way only the rows listed in ``rows`` get new observations, rewards and flags. It writes ``obs``, ``rew``, ``term`` and ``reason`` (0 running,
-1 numerical blow-up, 2 success, 3 failure) for every row. Observations are clipped to the
+way only the rows listed in ``rows`` get new observations, rewards, flags and ``reason``
+(0 running, 1 numerical blow-up, 2 success, 3 failure). Observations are clipped to the
 observation-space bounds. A row whose state is no longer finite after the step keeps its
 previous observation, gets reward 0 and terminates with reason 1.
 """
@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
@@ -37,7 +36,7 @@ REASONS = ("running", "numerical_blow_up", "success", "failure")
 
 
 @kernel
-def first_nonfinite_row(a):  # noqa: ANN001, ANN201
+def first_nonfinite_row(a):
     """Index of the first row of ``a`` holding a NaN or infinity, or -1."""
     for i in range(a.shape[0]):
         for k in range(a.shape[1]):
@@ -47,7 +46,7 @@ def first_nonfinite_row(a):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
+def _map_action(a, u0, B, u, i):
     """Clip row ``i`` of the actions to [-1, 1] and map it to inputs, ``u = u0 + B a``."""
     na = a.shape[1]
     for k in range(na):
@@ -60,7 +59,7 @@ def _map_action(a, u0, B, u, i):  # noqa: ANN001, ANN202
 
 
 @row_kernel
-def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):  # noqa: ANN001, ANN202
+def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):
     """Map row ``i``'s action to inputs, count the step and take one RK4 step.
 
     ``work`` is a tuple of five scratch vectors for :func:`rk4_row`.
@@ -72,7 +71,7 @@ def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):  # noqa: A
 
 
 @row_kernel
-def _begin_row(x, i, rew, term, reason):  # noqa: ANN001, ANN202
+def _begin_row(x, i, rew, term, reason):
     """Clear the flags of row ``i``; False (and terminate with a blow-up) if it is not finite."""
     reason[i] = RUNNING
     term[i] = False
@@ -86,24 +85,44 @@ def _begin_row(x, i, rew, term, reason):  # noqa: ANN001, ANN202
 
 
 @row_kernel
-def _clip_obs(obs, i, lo, hi):  # noqa: ANN001, ANN202
+def _clip_obs(obs, i, lo, hi):
     """Clip row ``i`` of the observations to the observation space bounds."""
     for k in range(obs.shape[1]):
         obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
 
 
 @row_kernel
-def _action_cost(a, i):  # noqa: ANN001, ANN202
+def _action_cost(a, i):
     s = 0.0
     for k in range(a.shape[1]):
         s += a[i, k] * a[i, k]
     return s
 
 
-def _heading(  # noqa: PLR0913
-    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    ipsi, obs_idx, schedule, hold_steps, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
-):  # noqa: ANN202
+def _heading(
+    advance,
+    rows,
+    model_id,
+    x,
+    u,
+    p,
+    c,
+    dt,
+    a,
+    u0,
+    B,
+    ipsi,
+    obs_idx,
+    schedule,
+    hold_steps,
+    steps,
+    obs,
+    rew,
+    term,
+    reason,
+    obs_lo,
+    obs_hi,
+):
     """Heading task: hold ``schedule[i, steps[i] // hold_steps]``.
 
     Observation ``[ssa(psi_d - psi), x[obs_idx]...]``; reward
@@ -133,10 +152,28 @@ def _heading(  # noqa: PLR0913
     return -1
 
 
-def _speed(  # noqa: PLR0913
-    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    schedule, hold_steps, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
-):  # noqa: ANN202
+def _speed(
+    advance,
+    rows,
+    model_id,
+    x,
+    u,
+    p,
+    c,
+    dt,
+    a,
+    u0,
+    B,
+    schedule,
+    hold_steps,
+    steps,
+    obs,
+    rew,
+    term,
+    reason,
+    obs_lo,
+    obs_hi,
+):
     """RVG speed task: hold the speed through the water ``u_r`` at the scheduled setpoint.
 
     Observation ``[u_d - u_r, u_r, T_1 / T_bollard, u_d]``; reward
@@ -171,7 +208,7 @@ def _speed(  # noqa: PLR0913
 
 
 @row_kernel
-def path_geometry(px, py, tangent, leg_length, seg, i):  # noqa: ANN001, ANN201
+def path_geometry(px, py, tangent, leg_length, seg, i):
     """Cross-track error and along-track distance left on the active leg ``seg[i]``.
 
     ``e = -(x - x_k) sin(chi_p) + (y - y_k) cos(chi_p)`` is positive when the ship is to the
@@ -186,11 +223,35 @@ def path_geometry(px, py, tangent, leg_length, seg, i):  # noqa: ANN001, ANN201
     return -dn * sn + de * cs, leg_length[i, k] - (dn * cs + de * sn)
 
 
-def _path(  # noqa: PLR0913
-    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    tangent, leg_length, leg_angle, turn, n_wp, seg, accept_radius,  # noqa: ANN001
-    max_cross_track, ref_speed, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
-):  # noqa: ANN202
+def _path(
+    advance,
+    rows,
+    model_id,
+    x,
+    u,
+    p,
+    c,
+    dt,
+    a,
+    u0,
+    B,
+    tangent,
+    leg_length,
+    leg_angle,
+    turn,
+    n_wp,
+    seg,
+    accept_radius,
+    max_cross_track,
+    ref_speed,
+    steps,
+    obs,
+    rew,
+    term,
+    reason,
+    obs_lo,
+    obs_hi,
+):
     """RVG path following along straight legs between waypoints.
 
     The active leg switches when the ship is within ``accept_radius`` of its end waypoint or has
@@ -254,10 +315,30 @@ def _path(  # noqa: PLR0913
     return -1
 
 
-def _target(  # noqa: PLR0913
-    advance, rows, model_id, x, u, p, c, dt, a, u0, B,  # noqa: ANN001
-    target, target_vel, distance, max_distance, steps, obs, rew, term, reason, obs_lo, obs_hi,  # noqa: ANN001
-):  # noqa: ANN202
+def _target(
+    advance,
+    rows,
+    model_id,
+    x,
+    u,
+    p,
+    c,
+    dt,
+    a,
+    u0,
+    B,
+    target,
+    target_vel,
+    distance,
+    max_distance,
+    steps,
+    obs,
+    rew,
+    term,
+    reason,
+    obs_lo,
+    obs_hi,
+):
     """RVG target tracking: close on a target moving at constant velocity and hold ``distance``.
 
     Observation ``[dx_b, dy_b, dvx_b, dvy_b, |p_t - p| - d_set, u, v, r, alpha_1, T_1 / T_b]``
@@ -314,6 +395,10 @@ def _target(  # noqa: PLR0913
 #: (serial, parallel) compilations of each task kernel, chosen by batch size.
 KERNELS = {
     name: (kernel(func), parallel_kernel(func))
-    for name, func in (("heading", _heading), ("speed", _speed), ("path", _path),
-                       ("target", _target))
+    for name, func in (
+        ("heading", _heading),
+        ("speed", _speed),
+        ("path", _path),
+        ("target", _target),
+    )
 }

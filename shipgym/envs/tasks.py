@@ -149,9 +149,25 @@ class Task:
     def _args(self, advance: bool, rows: np.ndarray) -> tuple[Any, ...]:
         m = self.model
         return (
-            advance, rows, m.model_id, self.x, self.u, m.p, self.c, self.dt, self.a, self.u0,
-            self.B, *self._kernel_args(), self.steps, self.obs, self.rew, self.term, self.reason,
-            self.obs_low, self.obs_high,
+            advance,
+            rows,
+            m.model_id,
+            self.x,
+            self.u,
+            m.p,
+            self.c,
+            self.dt,
+            self.a,
+            self.u0,
+            self.B,
+            *self._kernel_args(),
+            self.steps,
+            self.obs,
+            self.rew,
+            self.term,
+            self.reason,
+            self.obs_low,
+            self.obs_high,
         )
 
     def step(self) -> int:
@@ -404,7 +420,13 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
     change_range_deg = (10.0, 45.0)
     obs_state_names = ("r", "alpha1", "u", "v")
     obs_names = ("heading_error", "r", "alpha1", "u", "v")
-    obs_bounds = ((-math.pi, math.pi), (-0.5, 0.5), (-math.pi, math.pi), (-10.0, 15.0), (-10.0, 10.0))
+    obs_bounds = (
+        (-math.pi, math.pi),
+        (-0.5, 0.5),
+        (-math.pi, math.pi),
+        (-10.0, 15.0),
+        (-10.0, 10.0),
+    )
 
     def __init__(
         self,
@@ -492,10 +514,28 @@ class RVGPathTask(RVGMixin, Task):
     # draws: heading offset, cross-track offset, number of legs, first course, legs, turns
     n_task_draws = 4 + 2 * max_random_legs
     task_options = frozenset({"waypoints"})
-    obs_names = ("cross_track_error", "course_error", "along_track_left", "next_turn",
-                 "u", "v", "r", "alpha1", "thrust_fraction")
-    obs_bounds = ((-1e4, 1e4), (-math.pi, math.pi), (-1e4, 1e4), (-math.pi, math.pi),
-                  (-10.0, 15.0), (-10.0, 10.0), (-0.5, 0.5), (-math.pi, math.pi), (0.0, 1.0))
+    obs_names = (
+        "cross_track_error",
+        "course_error",
+        "along_track_left",
+        "next_turn",
+        "u",
+        "v",
+        "r",
+        "alpha1",
+        "thrust_fraction",
+    )
+    obs_bounds = (
+        (-1e4, 1e4),
+        (-math.pi, math.pi),
+        (-1e4, 1e4),
+        (-math.pi, math.pi),
+        (-10.0, 15.0),
+        (-10.0, 10.0),
+        (-0.5, 0.5),
+        (-math.pi, math.pi),
+        (0.0, 1.0),
+    )
 
     def __init__(
         self,
@@ -519,8 +559,17 @@ class RVGPathTask(RVGMixin, Task):
         self._setup_two_input_actions()
 
     def _kernel_args(self) -> tuple[Any, ...]:
-        return (self.tangent, self.leg_length, self.leg_angle, self.turn, self.n_wp, self.seg,
-                self.accept_radius, self.max_cross_track, SERVICE_SPEED)
+        return (
+            self.tangent,
+            self.leg_length,
+            self.leg_angle,
+            self.turn,
+            self.n_wp,
+            self.seg,
+            self.accept_radius,
+            self.max_cross_track,
+            SERVICE_SPEED,
+        )
 
     def _initial_states(self, draws: np.ndarray) -> np.ndarray:
         # Placed on the path by _reset_task: psi holds the offset from the first leg's course.
@@ -536,8 +585,12 @@ class RVGPathTask(RVGMixin, Task):
             path = np.asarray(value, dtype=np.float64)
         except (TypeError, ValueError):
             path = np.zeros((0, 2))
-        if (path.ndim != 2 or path.shape[1] != 2 or not 2 <= path.shape[0] <= self.max_waypoints
-                or not np.all(np.isfinite(path))):
+        if (
+            path.ndim != 2
+            or path.shape[1] != 2
+            or not 2 <= path.shape[0] <= self.max_waypoints
+            or not np.all(np.isfinite(path))
+        ):
             raise ValueError(
                 f"option 'waypoints' must be 2 to {self.max_waypoints} finite (north, east) "
                 f"points in m, got {value!r}"
@@ -618,10 +671,30 @@ class RVGTargetTask(RVGMixin, Task):
     kernel_name = "target"
     n_task_draws = 5  # heading, target range, bearing, course, speed
     task_options = frozenset({"target_position", "target_velocity", "distance"})
-    obs_names = ("target_x_body", "target_y_body", "target_vx_body", "target_vy_body",
-                 "distance_error", "u", "v", "r", "alpha1", "thrust_fraction")
-    obs_bounds = ((-1e5, 1e5), (-1e5, 1e5), (-50.0, 50.0), (-50.0, 50.0), (-1e5, 1e5),
-                  (-10.0, 15.0), (-10.0, 10.0), (-0.5, 0.5), (-math.pi, math.pi), (0.0, 1.0))
+    obs_names = (
+        "target_x_body",
+        "target_y_body",
+        "target_vx_body",
+        "target_vy_body",
+        "distance_error",
+        "u",
+        "v",
+        "r",
+        "alpha1",
+        "thrust_fraction",
+    )
+    obs_bounds = (
+        (-1e5, 1e5),
+        (-1e5, 1e5),
+        (-50.0, 50.0),
+        (-50.0, 50.0),
+        (-1e5, 1e5),
+        (-10.0, 15.0),
+        (-10.0, 10.0),
+        (-0.5, 0.5),
+        (-math.pi, math.pi),
+        (0.0, 1.0),
+    )
 
     def __init__(
         self,
@@ -669,7 +742,8 @@ class RVGTargetTask(RVGMixin, Task):
         if "target_velocity" in options:
             self.target_vel[rows] = _point("target_velocity", options["target_velocity"])
         self.distance[rows] = (
-            _finite_float("distance", options["distance"]) if "distance" in options
+            _finite_float("distance", options["distance"])
+            if "distance" in options
             else self.default_distance
         )
 

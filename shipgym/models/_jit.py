@@ -72,7 +72,10 @@ def parallel_kernel(func: F) -> F:
     parallel compilation of one function would otherwise overwrite and load each other.
     """
     clone = types.FunctionType(
-        func.__code__, func.__globals__, func.__name__ + "_parallel", func.__defaults__,
+        func.__code__,
+        func.__globals__,
+        func.__name__ + "_parallel",
+        func.__defaults__,
         func.__closure__,
     )
     clone.__qualname__ = func.__qualname__ + "_parallel"

@@ -127,18 +127,24 @@ class ShipModel:
         try:
             return self.state_names.index(name)
         except ValueError:
-            raise KeyError(f"model {self.name!r} has no state {name!r}; states: {self.state_names}") from None
+            raise KeyError(
+                f"model {self.name!r} has no state {name!r}; states: {self.state_names}"
+            ) from None
 
     def _batch(self, x: npt.ArrayLike, u: npt.ArrayLike, current: npt.ArrayLike | None):
         x = np.array(x, dtype=np.float64, ndmin=2)
         u = np.array(u, dtype=np.float64, ndmin=2)
         if x.ndim != 2 or x.shape[1] != self.nx:
-            raise ValueError(f"state must have shape (n, {self.nx}) {self.state_names}, got {x.shape}")
+            raise ValueError(
+                f"state must have shape (n, {self.nx}) {self.state_names}, got {x.shape}"
+            )
         n = x.shape[0]
         if u.shape == (1, self.nu) and n > 1:
             u = np.repeat(u, n, axis=0)
         if u.shape != (n, self.nu):
-            raise ValueError(f"input must have shape ({n}, {self.nu}) {self.input_names}, got {u.shape}")
+            raise ValueError(
+                f"input must have shape ({n}, {self.nu}) {self.input_names}, got {u.shape}"
+            )
         if current is None:
             c = np.zeros((n, 2))
         else:
@@ -146,7 +152,9 @@ class ShipModel:
             if c.shape == (1, 2) and n > 1:
                 c = np.repeat(c, n, axis=0)
             if c.shape != (n, 2):
-                raise ValueError(f"current must be (n, 2) north/east [m/s] with n={n}, got {c.shape}")
+                raise ValueError(
+                    f"current must be (n, 2) north/east [m/s] with n={n}, got {c.shape}"
+                )
         return x, u, c
 
     def deriv(
@@ -280,9 +288,7 @@ def make_model(
     if params is None:
         params = expected()
     elif not isinstance(params, expected):
-        raise ValueError(
-            f"model {name!r} takes {expected.__name__}, got {type(params).__name__}"
-        )
+        raise ValueError(f"model {name!r} takes {expected.__name__}, got {type(params).__name__}")
     if name == "rvg3dof":
         return ShipModel(name, params)
     return ShipModel(name, params, gear or SteeringGear(), surge or SurgeModel())

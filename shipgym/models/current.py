@@ -32,11 +32,11 @@ class Current:
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.speed) or self.speed < 0.0:
-            raise ValueError(
-                f"current speed must be a finite number >= 0 m/s, got {self.speed!r}"
-            )
+            raise ValueError(f"current speed must be a finite number >= 0 m/s, got {self.speed!r}")
         if not math.isfinite(self.direction):
-            raise ValueError(f"current direction must be a finite angle in rad, got {self.direction!r}")
+            raise ValueError(
+                f"current direction must be a finite angle in rad, got {self.direction!r}"
+            )
 
     @property
     def ned(self) -> tuple[float, float]:

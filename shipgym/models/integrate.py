@@ -15,7 +15,6 @@ compiled for parallel execution (``rk4_step_parallel``, the environments' large-
 from __future__ import annotations
 
 import numpy as np
-
 from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
@@ -26,7 +25,7 @@ NOMOTO1, NOMOTO2, NORRBIN, BECH, RVG3DOF = 0, 1, 2, 3, 4
 
 
 @row_kernel
-def row_rhs(model_id, x, u, p, c, out):  # noqa: ANN001, ANN201
+def row_rhs(model_id, x, u, p, c, out):
     """State derivative of one ship (1-D ``x``, ``u``, ``c``) written into ``out``."""
     if model_id == NOMOTO1:
         nomoto1_row(x, u, p, c, out)
@@ -41,14 +40,14 @@ def row_rhs(model_id, x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @kernel
-def rhs(model_id, x, u, p, c, out):  # noqa: ANN001, ANN201
+def rhs(model_id, x, u, p, c, out):
     """Batched state derivative of model ``model_id``, written into ``out``."""
     for i in range(x.shape[0]):
         row_rhs(model_id, x[i], u[i], p, c[i], out[i])
 
 
 @row_kernel
-def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):  # noqa: ANN001, ANN201
+def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
     """Advance row ``i`` of ``x`` in place by one classic RK4 step of ``h`` [s].
 
     ``k1`` to ``k4`` and ``t`` are scratch vectors of length nx (the slopes and the stage state).
@@ -76,7 +75,7 @@ PARALLEL_MIN_ROWS = 64
 CHUNK = 256
 
 
-def _rk4_batch(model_id, x, u, p, c, h):  # noqa: ANN001, ANN202
+def _rk4_batch(model_id, x, u, p, c, h):
     """Advance ``x`` in place by one RK4 step of length ``h`` [s], chunk by chunk."""
     n, m = x.shape
     n_chunks = (n + CHUNK - 1) // CHUNK

@@ -258,7 +258,7 @@ def pack_nomoto(
 
 
 @row_kernel
-def _actuators_and_kinematics(x, u, p, c, out):  # noqa: ANN001, ANN202
+def _actuators_and_kinematics(x, u, p, c, out):
     """Steering gear, surge and position kinematics; returns ``delta'``."""
     dmax = p[P_DMAX]
     rate = p[P_DRATE]
@@ -275,7 +275,7 @@ def _actuators_and_kinematics(x, u, p, c, out):  # noqa: ANN001, ANN202
 
 
 @row_kernel
-def nomoto1_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+def nomoto1_row(x, u, p, c, out):
     """First-order Nomoto derivative (seed 004 eq. 2)."""
     _actuators_and_kinematics(x, u, p, c, out)
     K, T = p[P_YAW], p[P_YAW + 1]
@@ -283,7 +283,7 @@ def nomoto1_row(x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def norrbin_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+def norrbin_row(x, u, p, c, out):
     """Norrbin derivative (seed 002 eq. 1-3, seed 004 eq. 4)."""
     _actuators_and_kinematics(x, u, p, c, out)
     K, T = p[P_YAW], p[P_YAW + 1]
@@ -294,7 +294,7 @@ def norrbin_row(x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def nomoto2_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+def nomoto2_row(x, u, p, c, out):
     """Second-order Nomoto derivative (seed 004 eq. 1)."""
     ddot = _actuators_and_kinematics(x, u, p, c, out)
     K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
@@ -304,7 +304,7 @@ def nomoto2_row(x, u, p, c, out):  # noqa: ANN001, ANN201
 
 
 @row_kernel
-def bech_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+def bech_row(x, u, p, c, out):
     """Bech derivative (seed 004 eq. 3)."""
     ddot = _actuators_and_kinematics(x, u, p, c, out)
     K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]

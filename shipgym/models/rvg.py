@@ -127,8 +127,14 @@ class RVGParams:
             value.flags.writeable = False
             object.__setattr__(self, name, value)
         for name in (
-            "mass", "yaw_inertia", "thrust_time_constant", "azimuth_time_constant",
-            "azimuth_max_rate", "azimuth_max", "bollard_thrust", "thrust_zero_speed",
+            "mass",
+            "yaw_inertia",
+            "thrust_time_constant",
+            "azimuth_time_constant",
+            "azimuth_max_rate",
+            "azimuth_max",
+            "bollard_thrust",
+            "thrust_zero_speed",
         ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
@@ -156,7 +162,14 @@ P_MRB = 27  # m11, m22, (m23 + m32) / 2 of M_rb
 P_MA_C = 30  # a11, a22, (a23 + a32) / 2 of M_a, for C_a
 P_DQ = 33  # D_u[0,0], D_v[1,1], D_r[2,2]
 P_POD = 36  # x1, y1, x2, y2
-P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = 40, 41, 42, 43, 44, 45  # 1/x saves divisions
+P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = (
+    40,
+    41,
+    42,
+    43,
+    44,
+    45,
+)  # 1/x saves divisions
 P_SIZE = 46
 
 
@@ -187,7 +200,7 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
 
 
 @row_kernel
-def _pod_state_rates(x, u, p, out, ur):  # noqa: ANN001, ANN202
+def _pod_state_rates(x, u, p, out, ur):
     """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
     tmax = p[P_TBOLL] * min(max(1.0 - ur * p[P_INV_U0], 0.0), 1.0)
     amax = p[P_AMAX]
@@ -200,7 +213,7 @@ def _pod_state_rates(x, u, p, out, ur):  # noqa: ANN001, ANN202
 
 
 @row_kernel
-def rvg_row(x, u, p, c, out):  # noqa: ANN001, ANN201
+def rvg_row(x, u, p, c, out):
     """RVG 3-DOF derivative (seed 001 eq. 5-20)."""
     psi = x[IPSI]
     cs = math.cos(psi)
@@ -230,7 +243,9 @@ def rvg_row(x, u, p, c, out):  # noqa: ANN001, ANN201
     t2 = x[IT2]
     fx = t1 * ca1 + t2 * ca2
     fy = t1 * sa1 + t2 * sa2
-    fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (-p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2)
+    fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (
+        -p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2
+    )
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
     m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
     a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
