@@ -29,6 +29,19 @@ def _bad_action(action: Any, expected: int, reason: str) -> ValueError:
     )
 
 
+def _checked_shape(action: Any, shape: tuple[int, ...], act_dim: int) -> Any:
+    """``action`` if it has ``shape`` (the fast path), else a converted copy or a ValueError."""
+    if getattr(action, "shape", None) == shape:
+        return action
+    try:
+        arr = np.asarray(action, dtype=np.float64)
+    except (ValueError, TypeError) as exc:
+        raise _bad_action(action, act_dim, str(exc)) from None
+    if arr.shape != shape:
+        raise _bad_action(action, act_dim, f"expected shape {shape}")
+    return arr
+
+
 class _Spaces:
     """Observation and action spaces shared by the single and the vector env."""
 
@@ -87,15 +100,7 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         task = self.task
-        if getattr(action, "shape", None) != self.action_space.shape:
-            try:
-                arr = np.asarray(action, dtype=np.float64)
-            except (ValueError, TypeError) as exc:
-                raise _bad_action(action, task.act_dim, str(exc)) from None
-            if arr.shape != self.action_space.shape:
-                raise _bad_action(action, task.act_dim, f"expected shape {self.action_space.shape}")
-            action = arr
-        task.a[0] = action
+        task.a[0] = _checked_shape(action, task.a.shape[1:], task.act_dim)
         if task.step() >= 0:
             raise _bad_action(action, task.act_dim, "it holds NaN or infinity")
         if self.render_mode == "human":
@@ -210,17 +215,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         task = self.task
-        if getattr(actions, "shape", None) != task.a.shape:
-            try:
-                arr = np.asarray(actions, dtype=np.float64)
-            except (ValueError, TypeError) as exc:
-                raise _bad_action(actions, task.act_dim, str(exc)) from None
-            if arr.shape != task.a.shape:
-                raise _bad_action(
-                    actions, task.act_dim, f"expected shape {task.a.shape} for {self.num_envs} envs"
-                )
-            actions = arr
-        task.a[:] = actions
+        task.a[:] = _checked_shape(actions, task.a.shape, task.act_dim)
         bad = task.step()
         if bad >= 0:
             raise _bad_action(
