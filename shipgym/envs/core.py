@@ -69,12 +69,10 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
             )
         self.render_mode = render_mode
         self.task = self.task_cls(1, **task_kwargs)
-        self._task_kwargs = task_kwargs
         self.observation_space, self.action_space = self._single_spaces()
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.dt)}
         self._renderer: Any = None
         self._trail: list[tuple[float, float]] = []
-        self._obs = np.zeros(self.task.obs_dim, dtype=np.float32)
 
     @property
     def dt(self) -> float:

@@ -28,10 +28,12 @@ from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import CHUNK, rk4_row
+from shipgym.models.integrate import rk4_row
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
+#: Rows per chunk of the (parallel) row loop; each chunk has its own RK4 scratch vectors.
+CHUNK = 256
 REASONS = ("running", "numerical_blow_up", "success", "failure")
 
 

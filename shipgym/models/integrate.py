@@ -7,17 +7,15 @@
 the input and current held over the step (seed 001 eq. 2). Every user of a model, the
 environments, the manoeuvres and identification, integrates through these functions.
 
-``rk4_step`` runs the four stages ship by ship on small work vectors that stay in the CPU
-cache, in chunks of rows that a ``prange`` loop spreads over all cores where the caller is
-compiled for parallel execution (``rk4_step_parallel``, the environments' large-batch kernels).
+Both run ship by ship through ``rk4_row``, whose four stages use small work vectors that stay
+in the CPU cache; the environments' kernels call ``rk4_row`` inside their own row loops.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from shipgym.models._jit import kernel, parallel_kernel, row_kernel
+from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.nomoto import bech_row, nomoto1_row, nomoto2_row, norrbin_row
 from shipgym.models.rvg import rvg_row
 
@@ -70,26 +68,14 @@ def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
         xi[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 
 
-#: Batches at least this large are integrated on all cores.
+#: Batches at least this large are stepped by the parallel compilation of the env kernels.
 PARALLEL_MIN_ROWS = 64
-CHUNK = 256
 
 
-def _rk4_batch(model_id, x, u, p, c, h):
-    """Advance ``x`` in place by one RK4 step of length ``h`` [s], chunk by chunk."""
-    n, m = x.shape
-    n_chunks = (n + CHUNK - 1) // CHUNK
-    work = np.empty((n_chunks, 5, m))
-    for k in prange(n_chunks):
-        w = work[k]
-        k1, k2, k3, k4, t = w[0], w[1], w[2], w[3], w[4]
-        for i in range(k * CHUNK, min(n, (k + 1) * CHUNK)):
-            rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
-
-
-#: One RK4 step of a batch. (The environments' kernels call ``rk4_row`` inside their own
-#: row loops; a cached kernel must not call a separately compiled parallel kernel, since
-#: Numba would cache a stale pointer to it.)
-rk4_step = kernel(_rk4_batch)
-#: The same step on all cores, for callers from Python with large batches.
-rk4_step_parallel = parallel_kernel(_rk4_batch)
+@kernel
+def rk4_step(model_id, x, u, p, c, h):
+    """Advance every row of ``x`` in place by one RK4 step of length ``h`` [s]."""
+    work = np.empty((5, x.shape[1]))
+    k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
+    for i in range(x.shape[0]):
+        rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
