@@ -665,3 +665,28 @@ def test_bad_inputs_raise_value_error_naming_the_problem() -> None:
         model.deriv(np.zeros(6), np.zeros(2), np.zeros(3))
     with pytest.raises(ValueError, match="dt must be"):
         model.simulate(np.zeros(6), np.zeros((5, 2)), 0.0)
+
+
+def test_linearize_matches_the_analytic_nomoto_jacobian() -> None:
+    params = Nomoto1Params(K=0.2, T=60.0)
+    model = make_model("nomoto1", params)
+    psi, speed = 0.3, 7.0
+    A, B = model.linearize([0.0, 0.0, psi, speed, 0.0, 0.0], [0.0, speed / model.surge.gain])
+    assert A[4, 4] == pytest.approx(-1.0 / params.T, rel=1e-8)  # dr'/dr
+    assert A[4, 5] == pytest.approx(params.K / params.T, rel=1e-8)  # dr'/ddelta
+    assert A[0, 2] == pytest.approx(-speed * np.sin(psi), rel=1e-6)  # dx'/dpsi
+    assert A[1, 3] == pytest.approx(np.sin(psi), rel=1e-6)  # dy'/dU
+    assert B[5, 0] == pytest.approx(1.0 / model.gear.time_constant, rel=1e-8)  # ddelta'/ddelta_c
+    assert B[3, 1] == pytest.approx(model.surge.gain / model.surge.time_constant, rel=1e-8)
+
+
+def test_linearized_rvg_is_directionally_unstable_at_service_speed() -> None:
+    """The documented property of the seed-001 model: one unstable sway-yaw eigenvalue."""
+    model = make_model("rvg3dof")
+    x0 = np.zeros(model.nx)
+    x0[3] = 5.144  # service speed [m/s]
+    x0[6:8] = RVGParams().service_thrust
+    A, _ = model.linearize(x0, [x0[6], x0[7], 0.0, 0.0])
+    eig = np.sort(np.linalg.eigvals(A[np.ix_([4, 5], [4, 5])]).real)
+    assert eig[0] < 0 < eig[1]
+    assert eig[1] == pytest.approx(0.18, abs=0.02)

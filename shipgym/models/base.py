@@ -181,6 +181,43 @@ class ShipModel:
         integrate.rhs(self.model_id, xb, ub, self.p, cb, out)
         return out
 
+    def linearize(
+        self,
+        x0: npt.ArrayLike,
+        u0: npt.ArrayLike,
+        current: npt.ArrayLike | None = None,
+        eps: float = 1e-6,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Jacobians ``A = df/dx`` and ``B = df/du`` at ``(x0, u0)`` by central differences.
+
+        Parameters
+        ----------
+        x0 : array_like
+            State, shape ``(nx,)``.
+        u0 : array_like
+            Input, shape ``(nu,)``.
+        current : array_like, optional
+            North/east current [m/s].
+        eps : float
+            Relative perturbation (scaled by ``max(1, |value|)`` per entry).
+
+        Returns
+        -------
+        A, B : numpy.ndarray
+            Shapes ``(nx, nx)`` and ``(nx, nu)``.
+        """
+        x0b, u0b, _ = self._batch(x0, u0, current)
+        n_cols = self.nx + self.nu
+        z = np.tile(np.concatenate((x0b[0], u0b[0])), (2 * n_cols, 1))
+        h = eps * np.maximum(1.0, np.abs(z[0]))
+        for k in range(n_cols):
+            z[2 * k, k] += h[k]
+            z[2 * k + 1, k] -= h[k]
+        _, _, c = self._batch(z[:, : self.nx], z[:, self.nx :], current)
+        f = self.deriv(z[:, : self.nx], z[:, self.nx :], c)
+        jac = ((f[0::2] - f[1::2]) / (2.0 * h[:, None])).T
+        return jac[:, : self.nx], jac[:, self.nx :]
+
     def step(
         self, x: npt.ArrayLike, u: npt.ArrayLike, dt: float, current: npt.ArrayLike | None = None
     ) -> np.ndarray:
