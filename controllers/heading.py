@@ -1,0 +1,705 @@
+r"""PID heading autopilot with a third-order reference model (seed 004 eq. 6-7, Fossen 2011).
+
+Plant used for the design: the first-order Nomoto model with the heading as output,
+
+.. math:: \frac{\psi}{\delta}(s) = \frac{K}{s (1 + T s)}
+          \quad\Leftrightarrow\quad T \dot r + r = K \delta, \; \dot\psi = r,
+
+where ``delta`` is the steering command: the rudder angle of a conventional ship (``K > 0``:
+positive rudder turns to starboard) or the common azimuth of the aft pods of R/V Gunnerus
+(whose high-frequency gain ``K / T`` is negative: positive azimuth turns to port). ``T < 0``
+describes a directionally unstable ship.
+
+Control law (seed 004 eq. 7 with the reference model's yaw rate fed forward)::
+
+    e       = ssa(psi_d - psi)                                  heading error [rad]
+    delta_c = Kp e + Ki integral(e dt) - Kd (r - r_d) + b0 [+ (T a_d + r_d) / K]
+
+followed by the actuator limits ``|delta_c| <= max_command`` and
+``|d delta_c / dt| <= max_rate``. ``b0`` is a constant rudder offset (seed 004 eq. 7); the
+integrator removes any remaining constant offset (a current, a bias ``n0``). The bracketed
+Nomoto feed-forward is optional. Anti-windup (``anti_windup``): the integrator is frozen while
+the command is limited (by angle or rate) and the error would drive it further into the limit
+(conditional integration), and by default it is also driven back by the excess
+``u - u_lim`` with the tracking time ``T_t = sqrt(T_i T_d)`` (back-calculation, Åström).
+The command is in the units of the plant input: rad for a rudder or an azimuth, N m for a
+yaw-moment command that a thrust allocation turns into pod angles.
+
+Pole placement (Fossen 2011, *Handbook of Marine Craft Hydrodynamics and Motion Control*, the
+PID pole-placement algorithm for the Nomoto heading model, "Fossen's method"): with the PID
+above the
+closed loop of the Nomoto plant has the characteristic polynomial
+
+.. math:: T s^3 + (1 + K K_d) s^2 + K K_p s + K K_i = 0 .
+
+``method="exact"`` (default) makes it equal to ``T (s^2 + 2 zeta w_n s + w_n^2)(s + w_n/10)``:
+
+.. math:: K_p = \frac{T (w_n^2 + 2 \zeta w_n p)}{K}, \quad
+          K_d = \frac{T (2 \zeta w_n + p) - 1}{K}, \quad
+          K_i = \frac{T w_n^2 p}{K}, \qquad p = w_n / 10,
+
+so the closed-loop poles are exactly ``-zeta w_n +- j w_n sqrt(1 - zeta^2)`` and ``-w_n/10``.
+``method="fossen"`` uses the textbook formulas ``K_p = w_n^2 T / K``,
+``K_d = (2 zeta w_n T - 1) / K``, ``K_i = w_n^3 T / (10 K)`` (the PD design with a slow
+integrator added: the dominant poles then move slightly). Both hold for any signs of ``K`` and
+``T``; :meth:`HeadingAutopilot.design_report` checks the resulting loop with python-control.
+
+Reference model (Fossen 2011, reference models for trajectory generation): a first-order
+low-pass in cascade with a
+mass-spring-damper,
+
+.. math:: \psi_d^{(3)} + (2\zeta_r + 1) w_r \ddot\psi_d + (2\zeta_r + 1) w_r^2 \dot\psi_d
+          + w_r^3 \psi_d = w_r^3 \psi_{ref},
+
+integrated as ``psi_f' = w_r (psi_ref - psi_f)``, ``a_d = w_r^2 (psi_f - psi_d) - 2 zeta_r
+w_r r_d`` (saturated to ``max_turn_accel``), ``r_d' = a_d`` (saturated to ``max_turn_rate``),
+``psi_d' = r_d``, with Heun (second-order Runge-Kutta) substeps of at most ``0.02 / w_r``
+seconds (the low-pass stage exactly). The yaw-rate limit ``max_turn_rate`` keeps a
+directionally unstable ship (R/V Gunnerus) from being asked for a turn rate it cannot check.
+Angles are unwrapped inside: a new setpoint is reached the short way (relative to the
+previous setpoint).
+
+R/V Gunnerus (shipgym ``rvg3dof`` at 5.14 m/s, azimuth of both pods as the command): the
+linearised sway-yaw model has an unstable pole at +0.18 1/s and an initial yaw acceleration
+of -0.0137 rad/s^2 per rad of azimuth, i.e. ``T = -5.57 s`` and ``K = 0.076 1/s``
+(``K / T < 0``: positive azimuth turns to port). Settings that hold 30 to 150 deg steps
+without overshoot in the nonlinear model: ``omega_n = 0.3``, ``reference_omega = 0.05``,
+``max_turn_rate = 0.02``, ``max_command = 35 deg``, ``max_rate = 10 deg/s``; a faster
+reference model lets the ship swing past 0.04 rad/s, a turn that full opposite azimuth
+checks only after tens of degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import control
+import numpy as np
+
+from controllers._angles import (
+    StepClock,
+    anti_windup_mode,
+    finite,
+    integrate_with_anti_windup,
+    nonnegative,
+    optional_limit,
+    positive,
+    ssa,
+    tracking_time,
+    unwrap_towards,
+)
+
+__all__ = [
+    "HeadingAutopilot",
+    "HeadingDesignReport",
+    "HeadingReferenceModel",
+    "default_bandwidth",
+    "pid_gains_nomoto",
+]
+
+#: Longest reference-model substep as a fraction of ``1 / w_r``.
+_REF_SUBSTEP = 0.02
+
+
+def pid_gains_nomoto(
+    K: float,
+    T: float,
+    omega_n: float,
+    zeta: float = 0.8,
+    *,
+    method: Literal["exact", "fossen"] = "exact",
+    integral_ratio: float = 0.1,
+) -> tuple[float, float, float]:
+    """PID gains ``(Kp, Ki, Kd)`` by pole placement on the Nomoto model ``K / (s (1 + T s))``.
+
+    Parameters
+    ----------
+    K : float
+        Nomoto gain [1/s] (non-zero, either sign).
+    T : float
+        Nomoto time constant [s] (non-zero; negative for a directionally unstable ship).
+    omega_n : float
+        Natural frequency [rad/s] of the dominant closed-loop poles.
+    zeta : float
+        Relative damping of the dominant poles (> 0).
+    method : {"exact", "fossen"}
+        ``"exact"`` places the poles exactly at ``-zeta w_n +- j w_n sqrt(1 - zeta^2)`` and
+        ``-integral_ratio w_n``; ``"fossen"`` uses Fossen's formulas (module docstring).
+    integral_ratio : float
+        The integrator pole (exact) or ``Ki / (w_n Kp)`` (fossen), 0.1 by default; 0 gives a PD.
+
+    Returns
+    -------
+    tuple of float
+        ``(Kp, Ki, Kd)`` in [command/rad, command/(rad s), command s/rad].
+
+    Raises
+    ------
+    ValueError
+        For ``K`` or ``T`` zero or not finite, ``omega_n`` or ``zeta`` not > 0, or an
+        unknown method.
+    """
+    K = finite("K", K)
+    T = finite("T", T)
+    if K == 0:
+        raise ValueError("Nomoto gain K must be non-zero, got 0")
+    if T == 0:
+        raise ValueError("Nomoto time constant T must be non-zero, got 0")
+    wn = positive("omega_n", omega_n)
+    zeta = positive("zeta", zeta)
+    ratio = nonnegative("integral_ratio", integral_ratio)
+    if method == "exact":
+        p = ratio * wn
+        kp = T * (wn * wn + 2.0 * zeta * wn * p) / K
+        kd = (T * (2.0 * zeta * wn + p) - 1.0) / K
+        ki = T * wn * wn * p / K
+    elif method == "fossen":
+        kp = wn * wn * T / K
+        kd = (2.0 * zeta * wn * T - 1.0) / K
+        ki = ratio * wn * kp
+    else:
+        raise ValueError(f"method must be 'exact' or 'fossen', got {method!r}")
+    return kp, ki, kd
+
+
+def default_bandwidth(
+    T: float,
+    *,
+    actuator_time_constant: float | None = None,
+    max_command: float | None = None,
+    max_rate: float | None = None,
+) -> float:
+    """Default natural frequency ``w_n`` [rad/s] for :meth:`HeadingAutopilot.from_nomoto`.
+
+    Fossen's rule for the bandwidth is ``1 / |T| < w_b < 1 / T_a``: faster than the ship's
+    yaw time constant, slower than the actuator. The actuator time ``T_a`` is the larger of
+    its time constant and its full-scale slew time ``max_command / max_rate`` (a large
+    heading change is limited by how fast the rudder can swing, not by the servo's time
+    constant). The default is the geometric mean ``w_n = sqrt(1 / (|T| T_a))``, the middle
+    of that band on a logarithmic scale; without actuator data ``T_a = |T| / 100``. For a
+    directionally unstable ship (``T < 0``) the loop must outrun the divergence rate
+    ``1 / |T|``, so ``w_n`` is at least ``2 / |T|``.
+
+    Examples: the Mariner (``T = 107.3 s``, 2 s servo, 35 deg at 2.32 deg/s, so
+    ``T_a = 15.1 s``) gets ``w_n = 0.025 rad/s``.
+    """
+    T = finite("T", T)
+    if T == 0:
+        raise ValueError("Nomoto time constant T must be non-zero, got 0")
+    ta = 0.0
+    if actuator_time_constant is not None:
+        ta = nonnegative("actuator_time_constant", actuator_time_constant)
+    umax = optional_limit("max_command", max_command)
+    rmax = optional_limit("max_rate", max_rate)
+    if math.isfinite(umax) and math.isfinite(rmax):
+        ta = max(ta, umax / rmax)
+    if ta == 0.0:
+        ta = abs(T) / 100.0
+    wn = math.sqrt(1.0 / (abs(T) * ta))
+    if T < 0:
+        wn = max(wn, 2.0 / abs(T))
+    return wn
+
+
+@dataclass(frozen=True, eq=False)
+class HeadingDesignReport:
+    """Closed-loop check of a heading autopilot design (python-control).
+
+    Attributes
+    ----------
+    kp, ki, kd : float
+        PID gains.
+    omega_n, zeta : float or None
+        Requested natural frequency [rad/s] and damping (``None`` for hand-set gains).
+    design_poles : numpy.ndarray
+        The poles that the pole placement asked for: the dominant pair and the integrator
+        pole (empty for hand-set gains).
+    closed_loop_poles : numpy.ndarray
+        Poles of ``L / (1 + L)`` with the plant used (sorted by real part, slowest first).
+    stable : bool
+        All closed-loop poles in the open left half plane.
+    gain_margin : float
+        Gain margin (ratio; ``inf`` when the phase never crosses -180 deg). For an
+        open-loop unstable plant a ratio below 1 is a *lower* gain margin.
+    phase_margin_deg : float
+        Phase margin [deg].
+    gain_crossover : float
+        Frequency [rad/s] where ``|L| = 1`` (``nan`` if none).
+    phase_crossover : float
+        Frequency [rad/s] where the phase of ``L`` is -180 deg (``nan`` if none).
+    plant, controller, loop : control.TransferFunction
+        ``psi / delta_c``, ``C(s) = Kp + Ki / s + Kd s`` and ``L = C P``.
+    """
+
+    kp: float
+    ki: float
+    kd: float
+    omega_n: float | None
+    zeta: float | None
+    design_poles: np.ndarray
+    closed_loop_poles: np.ndarray
+    stable: bool
+    gain_margin: float
+    phase_margin_deg: float
+    gain_crossover: float
+    phase_crossover: float
+    plant: control.TransferFunction
+    controller: control.TransferFunction
+    loop: control.TransferFunction
+
+
+class HeadingReferenceModel:
+    """Third-order heading reference model with rate and acceleration limits.
+
+    Parameters
+    ----------
+    omega : float
+        Reference-model natural frequency ``w_r`` [rad/s].
+    zeta : float
+        Reference-model damping ``zeta_r`` (1 is critically damped, no overshoot).
+    max_turn_rate : float, optional
+        Limit on ``|r_d|`` [rad/s]; none by default.
+    max_turn_accel : float, optional
+        Limit on ``|a_d|`` [rad/s^2]; none by default.
+
+    Attributes
+    ----------
+    psi_d, r_d, a_d : float
+        Desired heading [rad, unwrapped], yaw rate [rad/s] and yaw acceleration [rad/s^2].
+    """
+
+    def __init__(
+        self,
+        omega: float,
+        zeta: float = 1.0,
+        *,
+        max_turn_rate: float | None = None,
+        max_turn_accel: float | None = None,
+    ) -> None:
+        self.omega = positive("reference omega", omega)
+        self.zeta = positive("reference zeta", zeta)
+        self.max_turn_rate = optional_limit("max_turn_rate", max_turn_rate)
+        self.max_turn_accel = optional_limit("max_turn_accel", max_turn_accel)
+        self.reset(0.0)
+
+    def reset(self, psi: float, r: float = 0.0) -> None:
+        """Start at heading ``psi`` [rad] turning at ``r`` [rad/s] (clipped to the rate limit)."""
+        psi = finite("psi", psi)
+        self.psi_d = psi
+        self.psi_f = psi
+        self.psi_ref = psi
+        self.r_d = float(np.clip(finite("r", r), -self.max_turn_rate, self.max_turn_rate))
+        self.a_d = 0.0
+
+    def update(self, psi_ref: float, h: float) -> tuple[float, float, float]:
+        """Advance ``h`` seconds towards ``psi_ref`` [rad]; return ``(psi_d, r_d, a_d)``.
+
+        ``psi_ref`` is unwrapped next to the previous setpoint, so the model turns the short
+        way; ``psi_d`` is returned unwrapped (wrap it with ``ssa`` for display).
+        """
+        self.psi_ref = unwrap_towards(self.psi_ref, finite("psi_ref", psi_ref))
+        h = nonnegative("h", h)
+        w, z = self.omega, self.zeta
+        rmax, amax = self.max_turn_rate, self.max_turn_accel
+        n = max(1, math.ceil(h * w / _REF_SUBSTEP))
+        hs = h / n
+        decay = math.exp(-w * hs)
+        psi_d, r_d, psi_f, ref = self.psi_d, self.r_d, self.psi_f, self.psi_ref
+        w2, c = w * w, 2.0 * z * w
+        for _ in range(n):  # Heun's method (2nd order); psi_f is integrated exactly
+            a1 = min(max(w2 * (psi_f - psi_d) - c * r_d, -amax), amax)
+            psi_f = ref + (psi_f - ref) * decay
+            r_p = min(max(r_d + hs * a1, -rmax), rmax)
+            a2 = min(max(w2 * (psi_f - psi_d - hs * r_d) - c * r_p, -amax), amax)
+            psi_d += 0.5 * hs * (r_d + r_p)
+            r_d = min(max(r_d + 0.5 * hs * (a1 + a2), -rmax), rmax)
+        a = min(max(w2 * (psi_f - psi_d) - c * r_d, -amax), amax)
+        if abs(r_d) >= rmax and a * r_d > 0:
+            a = 0.0  # held at the rate limit
+        self.psi_d, self.r_d, self.psi_f, self.a_d = psi_d, r_d, psi_f, a
+        return psi_d, r_d, a
+
+    def transfer_function(self) -> control.TransferFunction:
+        """``psi_d / psi_ref = w^3 / (s^3 + (2 zeta + 1) w s^2 + (2 zeta + 1) w^2 s + w^3)``."""
+        w, z = self.omega, self.zeta
+        return control.tf([w**3], [1.0, (2 * z + 1) * w, (2 * z + 1) * w * w, w**3])
+
+
+class HeadingAutopilot:
+    """PID heading autopilot tracking a reference model (module docstring for the equations).
+
+    Parameters
+    ----------
+    kp, ki, kd : float
+        PID gains [command/rad, command/(rad s), command s/rad]. Their signs follow the
+        plant: all negative for a positive-azimuth-turns-to-port vessel with ``T > 0``.
+    dt : float
+        Nominal sample time [s] (used when :meth:`update` gets ``t=None``).
+    reference_omega : float, optional
+        Reference-model frequency ``w_r`` [rad/s]; ``None`` disables the reference model
+        (``psi_d = psi_ref``, ``r_d = 0``).
+    reference_zeta : float
+        Reference-model damping (1).
+    max_turn_rate, max_turn_accel : float, optional
+        Limits [rad/s, rad/s^2] of the reference model's ``r_d`` and ``a_d``.
+    max_command : float, optional
+        Command limit (e.g. 35 deg of rudder, in rad); none by default.
+    max_rate : float, optional
+        Command rate limit [command unit/s]; none by default.
+    offset : float
+        Constant command offset ``b0`` (seed 004 eq. 7).
+    anti_windup : {"conditional", "back_calculation", "none"} or bool
+        ``"back_calculation"`` (default, or ``True``): the integrator is frozen while the
+        command is limited and the error pushes it further into the limit, and it is driven
+        back by the excess,
+        ``integral' = e + (u_lim - u) / (ki T_t)`` with ``T_t = sqrt(T_i T_d)``
+        (``T_i = kp / ki``, ``T_d = kd / kp``). ``"conditional"``: only frozen (conditional
+        integration). ``"none"`` (or ``False``) integrates always (for comparison).
+    nomoto : tuple of float, optional
+        ``(K, T)`` of the plant: needed for :meth:`design_report` without a plant and for
+        the Nomoto feed-forward.
+    nomoto_feedforward : bool
+        Add ``(T a_d + r_d) / K`` to the command (needs ``nomoto``).
+    omega_n, zeta : float, optional
+        The design values (recorded for :meth:`design_report`).
+
+    Attributes
+    ----------
+    psi_d, r_d, a_d : float
+        Last reference heading [rad, wrapped to [-pi, pi)], yaw rate, acceleration.
+    error : float
+        Last heading error ``ssa(psi_d - psi)`` [rad].
+    integral : float
+        Heading-error integral [rad s]; the integral term is ``ki * integral``.
+    command : float
+        Last command (rad, or the plant's input unit) after the limits.
+    unsaturated_command : float
+        Last command before the limits.
+    """
+
+    def __init__(
+        self,
+        kp: float,
+        ki: float,
+        kd: float,
+        dt: float,
+        *,
+        reference_omega: float | None = None,
+        reference_zeta: float = 1.0,
+        max_turn_rate: float | None = None,
+        max_turn_accel: float | None = None,
+        max_command: float | None = None,
+        max_rate: float | None = None,
+        offset: float = 0.0,
+        anti_windup: str | bool = "back_calculation",
+        nomoto: tuple[float, float] | None = None,
+        nomoto_feedforward: bool = False,
+        omega_n: float | None = None,
+        zeta: float | None = None,
+    ) -> None:
+        self.kp = finite("kp", kp)
+        self.ki = finite("ki", ki)
+        self.kd = finite("kd", kd)
+        self._clock = StepClock(dt)
+        self.dt = self._clock.dt
+        self.reference: HeadingReferenceModel | None = None
+        if reference_omega is not None:
+            self.reference = HeadingReferenceModel(
+                reference_omega,
+                reference_zeta,
+                max_turn_rate=max_turn_rate,
+                max_turn_accel=max_turn_accel,
+            )
+        elif max_turn_rate is not None or max_turn_accel is not None:
+            raise ValueError("max_turn_rate and max_turn_accel need a reference model")
+        self.max_command = optional_limit("max_command", max_command)
+        self.max_rate = optional_limit("max_rate", max_rate)
+        self.offset = finite("offset", offset)
+        self.anti_windup = anti_windup_mode(anti_windup)
+        #: Back-calculation tracking time ``T_t`` [s].
+        self.tracking_time = tracking_time(self.kp, self.ki, self.kd)
+        if nomoto is not None:
+            try:
+                k_, t_ = nomoto
+            except (TypeError, ValueError):
+                raise ValueError(f"nomoto must be a pair (K, T), got {nomoto!r}") from None
+            k_, t_ = finite("nomoto K", k_), finite("nomoto T", t_)
+            if k_ == 0 or t_ == 0:
+                raise ValueError(f"nomoto (K, T) must both be non-zero, got {nomoto!r}")
+            self.nomoto: tuple[float, float] | None = (k_, t_)
+        else:
+            self.nomoto = None
+        if nomoto_feedforward and self.nomoto is None:
+            raise ValueError("nomoto_feedforward=True needs nomoto=(K, T)")
+        self.nomoto_feedforward = bool(nomoto_feedforward)
+        self.omega_n = None if omega_n is None else positive("omega_n", omega_n)
+        self.zeta = None if zeta is None else positive("zeta", zeta)
+        #: Poles asked for by :meth:`from_nomoto` (exact for ``method="exact"``).
+        self.design_poles = np.empty(0, dtype=complex)
+        #: Servo time constant [s] that :meth:`design_report` adds to the Nomoto plant.
+        self.actuator_time_constant = 0.0
+        self._initialised = False
+        self.reset(0.0)
+        self._initialised = False
+
+    # ------------------------------------------------------------------------------------
+    @classmethod
+    def from_nomoto(
+        cls,
+        K: float,
+        T: float,
+        dt: float,
+        *,
+        omega_n: float | None = None,
+        zeta: float = 0.8,
+        method: Literal["exact", "fossen"] = "exact",
+        integral_ratio: float = 0.1,
+        reference_omega: float | None = None,
+        reference_zeta: float = 1.0,
+        actuator_time_constant: float | None = None,
+        max_turn_rate: float | None = None,
+        max_turn_accel: float | None = None,
+        max_command: float | None = None,
+        max_rate: float | None = None,
+        offset: float = 0.0,
+        anti_windup: str | bool = "back_calculation",
+        nomoto_feedforward: bool = False,
+    ) -> HeadingAutopilot:
+        """Design by pole placement on ``psi / delta = K / (s (1 + T s))``.
+
+        Parameters
+        ----------
+        K, T : float
+            Nomoto gain [1/s] and time constant [s] of the command-to-yaw-rate response
+            (non-zero, any signs).
+        dt : float
+            Sample time [s].
+        omega_n : float, optional
+            Closed-loop natural frequency [rad/s]; :func:`default_bandwidth` of ``T`` and the
+            actuator data (``actuator_time_constant``, ``max_command``, ``max_rate``) if
+            omitted.
+        zeta : float
+            Closed-loop damping (0.8).
+        method, integral_ratio
+            See :func:`pid_gains_nomoto`.
+        reference_omega : float, optional
+            Reference-model frequency; ``omega_n`` by default (no faster than the loop that
+            tracks it). ``0`` disables the reference model.
+        actuator_time_constant : float, optional
+            Servo time constant [s]: used by the default ``omega_n`` and kept for
+            :meth:`design_report`.
+        Other parameters
+            As in :class:`HeadingAutopilot`.
+        """
+        if omega_n is None:
+            omega_n = default_bandwidth(
+                T,
+                actuator_time_constant=actuator_time_constant,
+                max_command=max_command,
+                max_rate=max_rate,
+            )
+        kp, ki, kd = pid_gains_nomoto(
+            K, T, omega_n, zeta, method=method, integral_ratio=integral_ratio
+        )
+        if reference_omega is None:
+            ref: float | None = omega_n
+        elif reference_omega == 0:
+            ref = None
+        else:
+            ref = reference_omega
+        pilot = cls(
+            kp,
+            ki,
+            kd,
+            dt,
+            reference_omega=ref,
+            reference_zeta=reference_zeta,
+            max_turn_rate=max_turn_rate,
+            max_turn_accel=max_turn_accel,
+            max_command=max_command,
+            max_rate=max_rate,
+            offset=offset,
+            anti_windup=anti_windup,
+            nomoto=(K, T),
+            nomoto_feedforward=nomoto_feedforward,
+            omega_n=omega_n,
+            zeta=zeta,
+        )
+        wn = float(omega_n)
+        wd = wn * np.sqrt(complex(1.0 - zeta * zeta))
+        poles = [-zeta * wn + 1j * wd, -zeta * wn - 1j * wd]
+        if integral_ratio > 0:
+            poles.append(complex(-integral_ratio * wn))
+        pilot.design_poles = np.array(poles, dtype=complex)
+        if actuator_time_constant is not None:
+            pilot.actuator_time_constant = nonnegative(
+                "actuator_time_constant", actuator_time_constant
+            )
+        return pilot
+
+    # ------------------------------------------------------------------------------------
+    def reset(
+        self,
+        psi: float,
+        r: float = 0.0,
+        *,
+        t: float | None = None,
+        command: float | None = None,
+        keep_offset: bool = False,
+    ) -> None:
+        """Restart at heading ``psi`` [rad] and yaw rate ``r`` [rad/s].
+
+        Parameters
+        ----------
+        psi, r : float
+            Measured heading and yaw rate; the reference model starts there.
+        t : float, optional
+            Time [s] of this state; the next :meth:`update` integrates from it.
+        command : float, optional
+            The actuator's present command, the start of the rate limiter; without it
+            the first command is not rate limited.
+        keep_offset : bool
+            Move the integral term into the offset (``b0 += ki * integral``) instead of
+            forgetting it: the learned rudder offset is kept for the next manoeuvre.
+        """
+        psi = finite("psi", psi)
+        r = finite("r", r)
+        if keep_offset:
+            self.offset += self.ki * getattr(self, "integral", 0.0)
+        self.integral = 0.0
+        if self.reference is not None:
+            self.reference.reset(psi, r)
+            self.psi_d, self.r_d, self.a_d = ssa(psi), self.reference.r_d, 0.0
+        else:
+            self.psi_d, self.r_d, self.a_d = ssa(psi), 0.0, 0.0
+        self.error = 0.0
+        self.command = math.nan if command is None else finite("command", command)
+        self.unsaturated_command = self.command
+        self._clock.reset(t)
+        self._initialised = True
+
+    @property
+    def offset_estimate(self) -> float:
+        """Estimated constant command offset: ``b0 + ki * integral``.
+
+        At a steady straight course the integral term settles at whatever constant command
+        the disturbances (rudder bias, current, wind) require; this is that estimate.
+        """
+        return self.offset + self.ki * self.integral
+
+    def update(self, t: float | None, psi: float, r: float, psi_ref: float) -> float:
+        """One controller step; returns the steering command.
+
+        Parameters
+        ----------
+        t : float or None
+            Sample time [s]; the step is the difference to the previous ``t`` (``dt`` when
+            ``None``). The first call after construction resets at the measured state.
+        psi : float
+            Measured heading [rad] (any wrapping).
+        r : float
+            Measured yaw rate [rad/s].
+        psi_ref : float
+            Heading setpoint [rad] (any wrapping; reached the short way).
+
+        Returns
+        -------
+        float
+            Steering command (rad for a rudder or azimuth) within ``max_command`` and the
+            rate limit.
+        """
+        psi = finite("psi", psi)
+        r = finite("r", r)
+        psi_ref = finite("psi_ref", psi_ref)
+        if not self._initialised:
+            self.reset(psi, r)
+        h = self._clock.step(t)
+        if self.reference is not None:
+            psi_d, r_d, a_d = self.reference.update(psi_ref, h)
+        else:
+            psi_d, r_d, a_d = psi_ref, 0.0, 0.0
+        e = ssa(psi_d - psi)
+        u = self.kp * e + self.ki * self.integral - self.kd * (r - r_d) + self.offset
+        if self.nomoto_feedforward and self.nomoto is not None:
+            K, T = self.nomoto
+            u += (T * a_d + r_d) / K
+        u_lim = min(max(u, -self.max_command), self.max_command)
+        if math.isfinite(self.max_rate) and math.isfinite(self.command):
+            step = self.max_rate * h
+            u_lim = min(max(u_lim, self.command - step), self.command + step)
+        self.integral = integrate_with_anti_windup(
+            self.integral, e, h, self.ki, u - u_lim, self.anti_windup, self.tracking_time
+        )
+        self.psi_d, self.r_d, self.a_d = ssa(psi_d), r_d, a_d
+        self.error = e
+        self.unsaturated_command = u
+        self.command = u_lim
+        return u_lim
+
+    # ------------------------------------------------------------------------------------
+    def design_report(
+        self,
+        plant: control.TransferFunction | None = None,
+        *,
+        actuator_time_constant: float | None = None,
+    ) -> HeadingDesignReport:
+        """Check the closed loop with python-control.
+
+        Parameters
+        ----------
+        plant : control.TransferFunction, optional
+            ``psi / delta_c``; by default the Nomoto model ``K / (s (1 + T s))`` of
+            ``nomoto`` (in series with ``1 / (1 + T_a s)`` if ``actuator_time_constant``).
+            Pass any linear model (e.g. a linearised 3-DOF model with an integrator).
+        actuator_time_constant : float, optional
+            ``T_a`` [s] of a first-order actuator added to the default plant; the one given
+            to :meth:`from_nomoto` (or none) by default.
+
+        Returns
+        -------
+        HeadingDesignReport
+
+        Raises
+        ------
+        ValueError
+            Without a plant when the autopilot has no ``nomoto`` model.
+        """
+        if actuator_time_constant is None:
+            actuator_time_constant = self.actuator_time_constant
+        ta = nonnegative("actuator_time_constant", actuator_time_constant)
+        if plant is None:
+            if self.nomoto is None:
+                raise ValueError("design_report needs a plant or an autopilot with nomoto=(K, T)")
+            K, T = self.nomoto
+            plant = control.tf([K], [T, 1.0, 0.0])
+            if ta > 0:
+                plant = plant * control.tf([1.0], [ta, 1.0])
+        elif not isinstance(plant, control.TransferFunction):
+            raise ValueError(f"plant must be a control.TransferFunction, got {type(plant)!r}")
+        controller = control.tf([self.kd, self.kp, self.ki], [1.0, 0.0])
+        loop = controller * plant
+        closed = control.feedback(loop, 1)
+        poles = np.asarray(control.poles(closed), dtype=complex)
+        poles = poles[np.argsort(-poles.real)]
+        stable = bool(np.all(poles.real < 0))
+        gm, pm, _sm, wpc, wgc, _wms = control.stability_margins(loop)
+        design = self.design_poles.copy()
+        return HeadingDesignReport(
+            kp=self.kp,
+            ki=self.ki,
+            kd=self.kd,
+            omega_n=self.omega_n,
+            zeta=self.zeta,
+            design_poles=design,
+            closed_loop_poles=poles,
+            stable=stable,
+            gain_margin=float(gm),
+            phase_margin_deg=float(pm),
+            gain_crossover=float(wgc),
+            phase_crossover=float(wpc),
+            plant=plant,
+            controller=controller,
+            loop=loop,
+        )

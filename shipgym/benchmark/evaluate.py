@@ -1,0 +1,247 @@
+"""Run a policy on an environment over seeded episodes and compute the task metrics.
+
+Episode ``k`` is reset with seed ``seed + k``, so every policy sees the same initial states,
+setpoints, paths, targets and current draws. Metrics (means over episodes):
+
+* heading envs: ``heading_rms_deg`` (RMS heading error over the whole episode),
+  ``overshoot_deg`` (largest excursion past a new setpoint, in the direction of the change,
+  over the setpoint segments of an episode), ``actuator_rms`` (RMS of the normalised command);
+* speed env: ``speed_rms_m_s``;
+* path following: ``cross_track_rms_m``, ``cross_track_final_m`` (mean |e| over the last 20 %
+  of the episode) and ``completed`` (fraction of episodes that reach the last waypoint);
+* target tracking: ``distance_error_rms_m`` and ``time_to_intercept_s`` (first time the distance
+  is within 10 % of the set distance; the episode length if never).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+import shipgym  # noqa: F401  (registers the environments)
+from shipgym.envs import ENV_IDS
+
+HEADING_ENVS = ("shipgym/NomotoHeading-v0", "shipgym/RVGHeading-v0")
+METRICS: dict[str, tuple[str, ...]] = {
+    "shipgym/NomotoHeading-v0": ("heading_rms_deg", "overshoot_deg", "actuator_rms"),
+    "shipgym/RVGHeading-v0": ("heading_rms_deg", "overshoot_deg", "actuator_rms"),
+    "shipgym/RVGSpeed-v0": ("speed_rms_m_s",),
+    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", "cross_track_final_m", "completed"),
+    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", "time_to_intercept_s"),
+}
+
+
+@dataclass
+class EpisodeLog:
+    """Signals of one episode, one row per step (after the step)."""
+
+    seed: int
+    time: list[float] = field(default_factory=list)
+    state: list[np.ndarray] = field(default_factory=list)
+    action: list[np.ndarray] = field(default_factory=list)
+    reward: list[float] = field(default_factory=list)
+    info: list[dict[str, Any]] = field(default_factory=list)
+    reset_info: dict[str, Any] = field(default_factory=dict)
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def signal(self, key: str) -> np.ndarray:
+        """An ``info`` entry over the episode as an array."""
+        return np.array([i[key] for i in self.info], dtype=float)
+
+    @property
+    def episode_return(self) -> float:
+        """Sum of rewards."""
+        return float(np.sum(self.reward))
+
+
+@dataclass
+class EvaluationResult:
+    """The summary object of ``shipgym evaluate`` and the logs behind it."""
+
+    env: str
+    controller: str
+    episodes: int
+    seed: int
+    returns: list[float]
+    per_episode: list[dict[str, float]]
+    logs: list[EpisodeLog] = field(repr=False)
+    options: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def metrics(self) -> dict[str, float]:
+        """Means over episodes of each metric."""
+        keys = METRICS[self.env]
+        return {k: float(np.mean([m[k] for m in self.per_episode])) for k in keys}
+
+    @property
+    def metrics_std(self) -> dict[str, float]:
+        """Standard deviations over episodes of each metric."""
+        keys = METRICS[self.env]
+        return {k: float(np.std([m[k] for m in self.per_episode])) for k in keys}
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object: env, controller, episodes, mean/std return and metric means."""
+        return {
+            "env": self.env,
+            "controller": self.controller,
+            "episodes": self.episodes,
+            "seed": self.seed,
+            "mean_return": float(np.mean(self.returns)),
+            "std_return": float(np.std(self.returns)),
+            "metrics": self.metrics,
+            "metrics_std": self.metrics_std,
+            "options": self.options,
+        }
+
+
+def _overshoot_deg(log: EpisodeLog) -> float:
+    """Largest overshoot past a new heading setpoint, in the direction of the change [deg]."""
+    setpoint = log.signal("heading_setpoint")
+    error = log.signal("heading_error")  # ssa(psi_d - psi)
+    start = log.reset_info.get("heading_setpoint", setpoint[0])
+    psi0 = start - log.reset_info.get("heading_error", 0.0)
+    previous_heading = psi0
+    worst = 0.0
+    k0 = 0
+    for k in range(1, len(setpoint) + 1):
+        if k == len(setpoint) or setpoint[k] != setpoint[k0]:
+            sp = setpoint[k0]
+            direction = math.copysign(1.0, _ssa(sp - previous_heading))
+            seg = -error[k0:k] * direction  # > 0 when the ship is past the setpoint
+            worst = max(worst, float(np.max(seg, initial=0.0)))
+            previous_heading = sp
+            k0 = k
+    return math.degrees(worst)
+
+
+def _ssa(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]:
+    """The metrics of one episode of ``env_id`` (see the module docstring)."""
+    if env_id in HEADING_ENVS:
+        e = log.signal("heading_error")
+        a = np.asarray(log.action, dtype=float)
+        return {
+            "heading_rms_deg": math.degrees(float(np.sqrt(np.mean(e**2)))),
+            "overshoot_deg": _overshoot_deg(log),
+            "actuator_rms": float(np.sqrt(np.mean(a**2))),
+        }
+    if env_id == "shipgym/RVGSpeed-v0":
+        e = log.signal("speed_error")
+        return {"speed_rms_m_s": float(np.sqrt(np.mean(e**2)))}
+    if env_id == "shipgym/RVGPathFollowing-v0":
+        e = log.signal("cross_track_error")
+        tail = e[int(0.8 * len(e)) :]
+        return {
+            "cross_track_rms_m": float(np.sqrt(np.mean(e**2))),
+            "cross_track_final_m": float(np.mean(np.abs(tail))),
+            "completed": float(bool(log.info[-1]["completed"])),
+        }
+    if env_id == "shipgym/RVGTargetTracking-v0":
+        err = log.signal("distance_error")
+        dist = log.signal("distance")
+        within = np.flatnonzero(np.abs(err) <= 0.1 * (dist - err))
+        t_int = (within[0] + 1) * dt if within.size else len(err) * dt
+        return {
+            "distance_error_rms_m": float(np.sqrt(np.mean(err**2))),
+            "time_to_intercept_s": float(t_int),
+        }
+    raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+
+
+def evaluate(
+    env_id: str,
+    policy: Any,
+    controller: str,
+    episodes: int = 10,
+    seed: int = 0,
+    env_kwargs: dict[str, Any] | None = None,
+    reset_options: dict[str, Any] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> EvaluationResult:
+    """Run ``policy`` for ``episodes`` episodes with seeds ``seed``, ``seed + 1``, ...
+
+    Parameters
+    ----------
+    env_id : str
+        One of :data:`shipgym.envs.ENV_IDS`.
+    policy : object
+        Has ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (normalised).
+    controller : str
+        Name recorded in the result.
+    episodes, seed : int
+        Number of episodes and the first seed.
+    env_kwargs : dict, optional
+        Keyword arguments for ``gymnasium.make`` (e.g. ``max_current_speed``).
+    reset_options : dict, optional
+        Options passed to every ``reset``.
+    progress : callable, optional
+        Called with a short line after each episode (default: print to stderr).
+
+    Returns
+    -------
+    EvaluationResult
+    """
+    if env_id not in ENV_IDS:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    if not isinstance(episodes, int) or episodes < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    if progress is None:
+        def progress(line: str) -> None:
+            print(line, file=sys.stderr, flush=True)
+    env = gym.make(env_id, **(env_kwargs or {}))
+    dt = env.unwrapped.dt
+    logs: list[EpisodeLog] = []
+    per_episode: list[dict[str, float]] = []
+    for k in range(episodes):
+        log = EpisodeLog(seed=seed + k)
+        obs, info = env.reset(seed=seed + k, options=reset_options)
+        log.reset_info = info
+        task = env.unwrapped.task
+        if hasattr(task, "waypoints"):
+            log.extras["waypoints"] = task.waypoints(0)
+        targets: list[np.ndarray] = []
+        policy.reset(env.unwrapped, obs, info)
+        t = 0.0
+        done = False
+        while not done:
+            action = np.asarray(policy.act(obs, info), dtype=np.float32)
+            obs, reward, terminated, truncated, info = env.step(action)
+            t += dt
+            log.time.append(t)
+            log.state.append(info["state"])
+            log.action.append(np.clip(action, -1.0, 1.0))
+            log.reward.append(float(reward))
+            log.info.append(info)
+            if hasattr(task, "target"):
+                targets.append(task.target[0].copy())
+            done = terminated or truncated
+        if targets:
+            log.extras["target"] = np.asarray(targets)
+        metrics = episode_metrics(env_id, log, dt)
+        logs.append(log)
+        per_episode.append(metrics)
+        progress(
+            f"{env_id} {controller} episode {k + 1}/{episodes} (seed {seed + k}): "
+            f"return {log.episode_return:.1f}, "
+            + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
+        )
+    env.close()
+    return EvaluationResult(
+        env=env_id,
+        controller=controller,
+        episodes=episodes,
+        seed=seed,
+        returns=[log.episode_return for log in logs],
+        per_episode=per_episode,
+        logs=logs,
+        options=dict(reset_options or {}),
+    )
