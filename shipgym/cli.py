@@ -6,6 +6,7 @@ Subcommands::
     shipgym bench [--steps N] [--num-envs N] [--repeats N] [--vec-steps N] [--json OUT]
                   [--plot OUT.png]
     shipgym envs
+    shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
 
 Each subcommand is registered by a builder in ``SUBCOMMANDS`` (name -> function that adds its
 parser and sets ``handler``), so later subcommands (simulate, evaluate, identify, train,
@@ -209,11 +210,253 @@ def _build_envs(sub: Any) -> None:
     p.set_defaults(handler=_run_envs)
 
 
+# ------------------------------------------------------------------------------------------
+# simulate
+# ------------------------------------------------------------------------------------------
+def _finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if value != value or value in (float("inf"), float("-inf")):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+# Each trial runner prints its metrics and returns (JSON payload, figure writer, IMO rows).
+_Trial = tuple[dict[str, Any], Callable[[str], Any], list[Any]]
+
+
+def _progress(msg: str) -> None:
+    print(f"  {msg}", file=sys.stderr, flush=True)
+
+
+def _simulate_zigzag(args: argparse.Namespace) -> _Trial:
+    import math
+
+    from shipgym import maneuvers as mv
+
+    a = 20.0 if args.angle_deg is None else args.angle_deg
+    n = 4 if args.reversals is None else args.reversals
+    res = mv.zigzag(args.model, a, args.heading_deg, args.side or "starboard", n, dt=args.dt)
+    over = ", ".join("not checked" if math.isnan(o) else f"{o:.2f}" for o in res.overshoots_deg)
+    print(
+        f"zigzag {res.label} ({res.first} first): {res.particulars.vessel} ({res.model}), "
+        f"U = {res.approach_speed:.2f} m/s"
+    )
+    print(f"  overshoots [deg]: {over}")
+    print(
+        f"  initial turning time {res.initial_turning_time:.1f} s, time to check yaw "
+        f"{res.time_to_check_yaw:.1f} s, period {res.period:.1f} s"
+    )
+    if not res.completed:
+        print("  the swing was not checked within the run (directionally unstable ship)")
+    rows = mv.imo_rows(res.particulars, zigzags=[res])
+    return res.to_dict(), lambda out: mv.plot_zigzag(res, out), rows
+
+
+def _simulate_turning(args: argparse.Namespace) -> _Trial:
+    import math
+
+    from shipgym import maneuvers as mv
+
+    a = 35.0 if args.angle_deg is None else args.angle_deg
+    res = mv.turning_circle(args.model, a, args.side or "starboard", dt=args.dt)
+    L = res.particulars.length
+    print(
+        f"turning circle {math.degrees(res.rudder):g} deg to {res.side}: "
+        f"{res.particulars.vessel} ({res.model}), L = {L:g} m, U = {res.approach_speed:.2f} m/s"
+    )
+    for name, value in (
+        ("advance", res.advance),
+        ("transfer", res.transfer),
+        ("tactical diameter", res.tactical_diameter),
+        ("steady turning diameter", res.steady_diameter),
+    ):
+        print(f"  {name:24s} {value:8.1f} m  ({value / L:.2f} L)")
+    loss = round(100.0 * (1.0 - res.speed_ratio), 1) + 0.0  # no "-0.0"
+    print(
+        f"  steady yaw rate {math.degrees(res.steady_yaw_rate):+.3f} deg/s, steady speed "
+        f"{res.steady_speed:.2f} m/s = {100 * res.speed_ratio:.1f} % of approach "
+        f"(speed loss {loss:.1f} %)"
+    )
+    rows = mv.imo_rows(res.particulars, turning=[res])
+    return res.to_dict(), lambda out: mv.plot_turning_circle(res, out), rows
+
+
+def _simulate_pullout(args: argparse.Namespace) -> _Trial:
+    import math
+
+    from shipgym import maneuvers as mv
+
+    a = 20.0 if args.angle_deg is None else args.angle_deg
+    res = mv.pullout(args.model, a, args.side or "starboard", dt=args.dt)
+    print(
+        f"pull-out after {math.degrees(res.rudder):g} deg to {res.side}: "
+        f"{res.particulars.vessel} ({res.model})"
+    )
+    print(
+        f"  turning yaw rate {math.degrees(res.turn_yaw_rate):+.4f} deg/s, residual "
+        f"{math.degrees(res.residual_yaw_rate):+.4f} deg/s -> "
+        f"{'stable' if res.stable else 'directionally UNSTABLE'}"
+    )
+    return res.to_dict(), lambda out: mv.plot_pullout(res, out), []
+
+
+def _simulate_spiral(args: argparse.Namespace) -> _Trial:
+    import math
+
+    from shipgym import maneuvers as mv
+
+    if args.side is not None:
+        raise ValueError("--side does not apply to the spiral (it sweeps both sides)")
+    rudders = None
+    if args.angle_deg is not None:
+        if not 0 < args.angle_deg <= 35:
+            raise ValueError(f"--angle-deg must be in (0, 35] deg, got {args.angle_deg!r}")
+        fractions = (1.0, 0.75, 0.5, 0.25, 0.15, 0.1, 0.05)
+        leg = [args.angle_deg * f for f in fractions]
+        rudders = [*leg, 0.0, *(-d for d in reversed(leg))]
+    kinds = ("direct", "reverse") if args.kind in (None, "both") else (args.kind,)
+    results = [mv.spiral(args.model, rudders, k, dt=args.dt, progress=_progress) for k in kinds]
+    for res in results:
+        print(f"{res.kind} spiral: {res.particulars.vessel} ({res.model})")
+        print("  rudder [deg]   r [deg/s]   leg")
+        for d, r, leg_name in zip(res.rudder, res.yaw_rate, res.leg, strict=True):
+            print(f"  {math.degrees(d):+11.3f}  {math.degrees(r):+10.4f}   {leg_name}")
+        if res.hysteresis:
+            print(
+                f"  hysteresis: loop width about {math.degrees(res.loop_width):.1f} deg "
+                "(directionally unstable)"
+            )
+        else:
+            print("  no hysteresis (directionally stable)")
+    payload = {"manoeuvre": "spiral", "spirals": [r.to_dict() for r in results]}
+    return payload, lambda out: mv.plot_spiral(results, out), []
+
+
+def _simulate_imo(args: argparse.Namespace) -> _Trial:
+    from shipgym import maneuvers as mv
+
+    if args.side is not None:
+        raise ValueError("--side does not apply to 'imo' (both sides are tested)")
+    if args.angle_deg is not None:
+        raise ValueError("--angle-deg does not apply to 'imo' (its trials are fixed)")
+    report = mv.imo_criteria(args.model, dt=args.dt, progress=_progress)
+    print(mv.format_imo_table(report))
+    print(f"overall: {'PASS' if report.passed else 'FAIL'}")
+    return report.to_dict(), lambda out: mv.plot_imo(report, out), []
+
+
+_SIMULATE: dict[str, Callable[[argparse.Namespace], _Trial]] = {
+    "zigzag": _simulate_zigzag,
+    "turning": _simulate_turning,
+    "pullout": _simulate_pullout,
+    "spiral": _simulate_spiral,
+    "imo": _simulate_imo,
+}
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from shipgym.maneuvers import PARTICULARS, format_imo_table
+
+    kind = args.manoeuvre
+    for flag, value, only in (
+        ("--kind", args.kind, "spiral"),
+        ("--heading-deg", args.heading_deg, "zigzag"),
+        ("--reversals", args.reversals, "zigzag"),
+    ):
+        if value is not None and kind != only:
+            raise ValueError(f"{flag} applies to the {only} only, not to {kind!r}")
+    if args.plot and Path(args.plot).suffix.lower() != ".png":
+        raise ValueError(f"--plot must name a .png file, got {args.plot!r}")
+    print(f"shipgym simulate {kind} --model {args.model} ...", file=sys.stderr, flush=True)
+    payload, draw, rows = _SIMULATE[kind](args)
+    if kind in ("zigzag", "turning"):
+        lu = PARTICULARS[args.model].length_over_speed
+        title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
+        print(format_imo_table(rows, title=title))
+        payload["imo"] = [row.to_dict() for row in rows]
+    if args.json:
+        out = Path(args.json)
+        out.write_text(json.dumps(payload, indent=1, allow_nan=False) + "\n")
+        print(f"wrote {out}")
+    if args.plot:
+        print(f"wrote {draw(args.plot)}")
+    return 0
+
+
+def _build_simulate(sub: Any) -> None:
+    from shipgym.models import MODEL_NAMES
+
+    p = sub.add_parser(
+        "simulate",
+        help="standard manoeuvres (zigzag, turning circle, pull-out, spiral) and IMO criteria",
+        description=(
+            "Simulate a standard manoeuvring trial on one model and print its metrics: "
+            "zigzag a/b (overshoots, initial turning time, time to check yaw, period), "
+            "turning circle (advance, transfer, tactical and steady diameter, speed loss), "
+            "pull-out (residual yaw rate), spiral (direct/reverse delta-r curve, hysteresis) "
+            "or 'imo', the IMO MSC.137(76) criteria to both sides as a pass/fail table. "
+            "For rvg3dof the rudder is the common pod azimuth at service thrust with the sign "
+            "flipped (positive = starboard turn)."
+        ),
+    )
+    p.add_argument("manoeuvre", choices=tuple(_SIMULATE), help="trial to run")
+    p.add_argument(
+        "--model", default="nomoto1", choices=MODEL_NAMES, help="model (default: %(default)s)"
+    )
+    p.add_argument(
+        "--angle-deg",
+        type=_finite_float,
+        default=None,
+        metavar="A",
+        help="rudder angle [deg]: zigzag a (20), turning (35), pull-out (20), largest "
+        "angle of the direct spiral (20)",
+    )
+    p.add_argument(
+        "--heading-deg",
+        type=_finite_float,
+        default=None,
+        metavar="B",
+        help="zigzag: heading change b [deg] at which the rudder is reversed (default: A)",
+    )
+    p.add_argument(
+        "--side",
+        choices=("starboard", "port"),
+        default=None,
+        help="turn side (turning, pull-out) or first rudder side (zigzag); default starboard",
+    )
+    p.add_argument(
+        "--reversals",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="zigzag: number of rudder reversals (default 4)",
+    )
+    p.add_argument(
+        "--kind",
+        choices=("direct", "reverse", "both"),
+        default=None,
+        help="spiral: direct (Dieudonne), reverse (Bech) or both (default)",
+    )
+    p.add_argument(
+        "--dt", type=_finite_float, default=None, metavar="S", help="integration step [s]"
+    )
+    p.add_argument("--json", default=None, metavar="OUT", help="write the results as JSON")
+    p.add_argument("--plot", default=None, metavar="OUT.png", help="write the standard figure")
+    p.set_defaults(handler=_run_simulate)
+
+
 #: Subcommand name -> builder. Planned: simulate, evaluate, identify, train, benchmark.
 SUBCOMMANDS: dict[str, Builder] = {
     "demo": _build_demo,
     "bench": _build_bench,
     "envs": _build_envs,
+    "simulate": _build_simulate,
 }
 
 
