@@ -416,6 +416,8 @@ class HeadingAutopilot:
             raise ValueError("max_turn_rate and max_turn_accel need a reference model")
         self.max_command = optional_limit("max_command", max_command)
         self.max_rate = optional_limit("max_rate", max_rate)
+        #: Limit [rad/s] on the yaw rate the heading loop may ask for (see :meth:`update`).
+        self.max_turn_rate = optional_limit("max_turn_rate", max_turn_rate)
         self.offset = finite("offset", offset)
         self.anti_windup = anti_windup_mode(anti_windup)
         #: Back-calculation tracking time ``T_t`` [s].
@@ -621,11 +623,20 @@ class HeadingAutopilot:
         else:
             psi_d, r_d, a_d = psi_ref, 0.0, 0.0
         e = ssa(psi_d - psi)
-        u = self.kp * e + self.ki * self.integral - self.kd * (r - r_d) + self.offset
+        heading_part = self.kp * e + self.ki * self.integral
+        u = heading_part - self.kd * (r - r_d) + self.offset
+        u_applied = u
+        if math.isfinite(self.max_turn_rate) and self.kd != 0.0:
+            # The PID as a cascade: u = -Kd (r - r_cmd) + b0 with the yaw-rate demand
+            # r_cmd = r_d + (Kp e + Ki int e) / Kd. Clipping r_cmd keeps a large heading
+            # error from asking for a turn the ship cannot check (an unstable ship).
+            r_cmd = r_d + heading_part / self.kd
+            r_lim = min(max(r_cmd, -self.max_turn_rate), self.max_turn_rate)
+            u_applied = -self.kd * (r - r_lim) + self.offset
         if self.nomoto_feedforward and self.nomoto is not None:
             K, T = self.nomoto
             u += (T * a_d + r_d) / K
-        u_lim = min(max(u, -self.max_command), self.max_command)
+        u_lim = min(max(u_applied, -self.max_command), self.max_command)
         if math.isfinite(self.max_rate) and math.isfinite(self.command):
             step = self.max_rate * h
             u_lim = min(max(u_lim, self.command - step), self.command + step)

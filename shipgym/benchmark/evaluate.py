@@ -195,8 +195,10 @@ def evaluate(
     if not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
     if progress is None:
+
         def progress(line: str) -> None:
             print(line, file=sys.stderr, flush=True)
+
     env = gym.make(env_id, **(env_kwargs or {}))
     dt = env.unwrapped.dt
     logs: list[EpisodeLog] = []

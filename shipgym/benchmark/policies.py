@@ -38,8 +38,8 @@ from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEE
 
 #: Gunnerus heading autopilot settings (``controllers.heading`` module docstring).
 RVG_OMEGA_N = 0.3
-RVG_REFERENCE_OMEGA = 0.05
-RVG_MAX_TURN_RATE = 0.02
+RVG_REFERENCE_OMEGA = 0.1
+RVG_MAX_TURN_RATE = 0.03
 #: LOS lookahead for the Gunnerus: three ship lengths.
 RVG_LOOKAHEAD = 3.0 * LPP
 
@@ -273,5 +273,3 @@ def make_policy(name: str, env_id: str) -> Any:
             raise ValueError(f"unknown env {env_id!r}; expected one of {tuple(_CLASSIC)}")
         return _CLASSIC[env_id]()
     raise ValueError(f"unknown controller {name!r}; expected one of {POLICIES}")
-
-

@@ -258,9 +258,10 @@ def _path(
 
     The active leg switches when the ship is within ``accept_radius`` of its end waypoint or has
     passed it along the track. Observation ``[e, ssa(chi_p - psi), s_left, turn, u, v, r,
-    alpha_1, T_1 / T_bollard]``. Reward per step ``-min(|e| / 50, 1) - 0.1 |chi_p - psi| / pi
-    + 0.5 progress / (ref_speed dt) - 0.05 |a|^2``; +10 on reaching the last waypoint, -10 when
-    ``|e| > max_cross_track``.
+    alpha_1, T_1 / T_bollard]``. Reward per step ``0.5 clip(progress / (ref_speed dt), -1, 1)
+    + 0.5 exp(-(e / 25 m)^2) - 0.1 |chi_p - psi| / pi - 0.05 |a|^2`` (at most 1, positive while
+    on the path and making way, so ending an episode early never pays); +20 on reaching the
+    last waypoint, -20 when ``|e| > max_cross_track``.
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -291,11 +292,11 @@ def _path(
                     else:
                         term[i] = True
                         reason[i] = SUCCESS
-                        bonus = 10.0
+                        bonus = 20.0
                 if abs(e) > max_cross_track:
                     term[i] = True
                     reason[i] = FAILURE
-                    bonus = -10.0
+                    bonus = -20.0
                 chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
                 obs[i, 0] = e
                 obs[i, 1] = chi_err
@@ -307,9 +308,9 @@ def _path(
                 obs[i, 7] = x[i, 8]
                 obs[i, 8] = x[i, 6] / tb
                 rew[i] = (
-                    -min(abs(e) / 50.0, 1.0)
+                    0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
+                    + 0.5 * math.exp(-((e / 25.0) ** 2))
                     - 0.1 * abs(chi_err) / math.pi
-                    + 0.5 * progress / (ref_speed * dt)
                     - 0.05 * _action_cost(a, i)
                     + bonus
                 )
@@ -345,8 +346,8 @@ def _target(
 
     Observation ``[dx_b, dy_b, dvx_b, dvy_b, |p_t - p| - d_set, u, v, r, alpha_1, T_1 / T_b]``
     with the target's relative position and velocity in the body frame. Reward
-    ``-min(|d - d_set| / 100, 2) - 0.05 |a|^2``; -10 and termination when the distance exceeds
-    ``max_distance``.
+    ``1 - min(|d - d_set| / 100, 2) - 0.05 |a|^2`` (positive within 100 m of the set distance);
+    -20 and termination when the distance exceeds ``max_distance``.
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -385,11 +386,11 @@ def _target(
                 obs[i, 7] = x[i, 5]
                 obs[i, 8] = x[i, 8]
                 obs[i, 9] = x[i, 6] / tb
-                rew[i] = -min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
+                rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
                 if d > max_distance:
                     term[i] = True
                     reason[i] = FAILURE
-                    rew[i] -= 10.0
+                    rew[i] -= 20.0
                 _clip_obs(obs, i, obs_lo, obs_hi)
     return -1
 

@@ -43,9 +43,10 @@ class RVGPathFollowingEnv(ShipEnv):
 
     ## Rewards
 
-    ``-min(|e| / 50 m, 1) - 0.1 |chi_p - psi| / pi + 0.5 (progress along the track) /
-    (5.14 m/s dt) - 0.05 |a|^2`` per step; +10 on reaching the last waypoint, -10 when the
-    cross-track error exceeds ``max_cross_track``.
+    ``0.5 clip(progress / (5.14 m/s dt), -1, 1) + 0.5 exp(-(e / 25 m)^2) - 0.1 |chi_p - psi| / pi
+    - 0.05 |a|^2`` per step (at most 1; positive while the ship is near the path and making way
+    along it, so ending an episode early never pays), +20 on reaching the last waypoint, -20
+    when the cross-track error exceeds ``max_cross_track``.
 
     ## Starting State
 

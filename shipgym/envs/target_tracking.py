@@ -38,8 +38,8 @@ class RVGTargetTrackingEnv(ShipEnv):
 
     ## Rewards
 
-    ``-min(|d - d_set| / 100 m, 2) - 0.05 |a|^2`` per step; -10 when the distance exceeds
-    ``max_distance``.
+    ``1 - min(|d - d_set| / 100 m, 2) - 0.05 |a|^2`` per step (positive within 100 m of the set
+    distance); -20 when the distance exceeds ``max_distance``.
 
     ## Starting State
 
