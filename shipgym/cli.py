@@ -7,10 +7,12 @@ Subcommands::
                   [--plot OUT.png]
     shipgym envs
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
+    shipgym evaluate --env ID [--controller classic|zero] [--episodes N] [--seed S]
+                     [--json OUT] [--plot DIR]
 
 Each subcommand is registered by a builder in ``SUBCOMMANDS`` (name -> function that adds its
-parser and sets ``handler``), so later subcommands (simulate, evaluate, identify, train,
-benchmark) plug in with one entry. Bad input ends with a one-line message and exit code 2
+parser and sets ``handler``), so later subcommands (identify, train, benchmark) plug in with
+one entry. Bad input ends with a one-line message and exit code 2
 (argparse's own message for bad arguments, ``shipgym: error: ...`` for a ``ValueError`` raised
 by the library), never a traceback. Heavy imports happen inside the handlers, so
 ``shipgym --help`` is fast.
@@ -451,12 +453,81 @@ def _build_simulate(sub: Any) -> None:
     p.set_defaults(handler=_run_simulate)
 
 
-#: Subcommand name -> builder. Planned: simulate, evaluate, identify, train, benchmark.
+#: Subcommand name -> builder. Planned: identify, train, benchmark.
+# ------------------------------------------------------------------------------------------
+# evaluate
+# ------------------------------------------------------------------------------------------
+def _run_evaluate(args: argparse.Namespace) -> int:
+    import json
+
+    from shipgym.benchmark import evaluate, make_policy
+    from shipgym.benchmark.plots import plot_result
+
+    policy = make_policy(args.controller, args.env)
+    result = evaluate(
+        args.env,
+        policy,
+        args.controller,
+        episodes=args.episodes,
+        seed=args.seed,
+        env_kwargs={}
+        if args.max_current_speed is None
+        else {"max_current_speed": args.max_current_speed},
+    )
+    summary = result.to_dict()
+    print(
+        f"{args.env} controller {args.controller}: {args.episodes} episodes from seed {args.seed}"
+    )
+    print(f"  return {summary['mean_return']:.2f} +- {summary['std_return']:.2f}")
+    for key, value in summary["metrics"].items():
+        print(f"  {key:22s} {value:10.3f} +- {summary['metrics_std'][key]:.3f}")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(summary, fh, indent=2)
+        print(f"wrote {args.json}")
+    if args.plot:
+        for path in plot_result(result, args.plot, max_episodes=args.episodes):
+            print(f"wrote {path}")
+    return 0
+
+
+def _build_evaluate(sub: Any) -> None:
+    from shipgym.benchmark.policies import POLICIES
+    from shipgym.envs import ENV_IDS
+
+    p = sub.add_parser(
+        "evaluate",
+        help="run a controller on an env over seeded episodes and report the task metrics",
+        description=(
+            "Run the classic controller (or the zero baseline) of an env for N episodes with "
+            "seeds S, S+1, ... (identical initial states, setpoints, paths, targets and "
+            "currents for every controller) and print the mean return and the task metrics."
+        ),
+    )
+    p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
+    p.add_argument("--controller", default="classic", choices=POLICIES, help="%(default)s")
+    p.add_argument("--episodes", type=_positive_int, default=10, metavar="N")
+    p.add_argument("--seed", type=int, default=0, metavar="S", help="first seed (%(default)s)")
+    p.add_argument(
+        "--max-current-speed",
+        type=_finite_float,
+        default=None,
+        metavar="M_S",
+        help="upper end of the drawn current speed [m/s] (default: the env's)",
+    )
+    p.add_argument("--json", default=None, metavar="OUT", help="write the summary as JSON")
+    p.add_argument(
+        "--plot", default=None, metavar="DIR", help="write a figure per episode into DIR"
+    )
+    p.set_defaults(handler=_run_evaluate)
+
+
 SUBCOMMANDS: dict[str, Builder] = {
     "demo": _build_demo,
     "bench": _build_bench,
     "envs": _build_envs,
     "simulate": _build_simulate,
+    "evaluate": _build_evaluate,
 }
 
 

@@ -222,7 +222,11 @@ class RVGPathClassic:
 
 
 class RVGTargetClassic:
-    """Constant-bearing guidance (seed 004 eq. 11) commanding heading and speed autopilots."""
+    """Constant-bearing guidance (seed 004 eq. 11) commanding heading and speed autopilots.
+
+    The guidance gives a course and a speed over ground; the heading setpoint is that course
+    minus the measured crab angle, and the speed autopilot holds the speed over ground.
+    """
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         task = env.task
@@ -246,8 +250,11 @@ class RVGTargetClassic:
         ship_velocity = rot @ state[[IU, IV]]
         target_velocity = ship_velocity + rot @ obs[2:4]
         chi_d, u_d = self.guidance.update(self.t, state[:2], target, target_velocity)
-        azimuth = self.heading.update(self.t, psi, state[IR], chi_d)
-        thrust = self.speed.update(self.t, float(state[IU]), u_d)
+        # the guidance asks for a course and speed over ground: steer the heading that gives
+        # that course with the measured sideslip (current, drift), and hold the ground speed
+        crab = math.atan2(ship_velocity[1], ship_velocity[0]) - psi
+        azimuth = self.heading.update(self.t, psi, state[IR], chi_d - crab)
+        thrust = self.speed.update(self.t, float(np.hypot(*ship_velocity)), u_d)
         self.t += self.dt
         return PodCommand(azimuth, thrust).to_env_action("target", max_azimuth=self.max_azimuth)
 

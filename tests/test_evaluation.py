@@ -1,0 +1,192 @@
+"""Closed-loop behaviour of the classic controllers on the environments, and ``shipgym evaluate``.
+
+Issue 3, section 4: LOS with the conditional integrator in a cross current (with its
+ablation), the Gunnerus heading autopilot in current, target tracking, and the classic
+controller beating the ``zero`` baseline on every env.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipgym.benchmark import evaluate, make_policy
+from shipgym.benchmark.policies import RVGHeadingClassic, RVGPathClassic, RVGTargetClassic
+from shipgym.cli import main
+from shipgym.envs import ENV_IDS
+from shipgym.models.rvg import LPP, SERVICE_SPEED
+
+
+def _quiet(line: str) -> None:
+    pass
+
+
+def _straight_run(integral: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The Gunnerus on a 3.5 km northbound leg in a 0.5 m/s current toward the east."""
+    options = {
+        "waypoints": [[0.0, 0.0], [3500.0, 0.0]],
+        "current_speed": 0.5,
+        "current_direction": math.pi / 2,
+        "initial_state": {"psi": 0.0, "u": SERVICE_SPEED, "T1": 25e3, "T2": 25e3},
+    }
+    # lookahead 6 L: the LOS loop (bandwidth U / Delta) well below the heading loop
+    policy = RVGPathClassic(integral=integral, lookahead=6 * LPP)
+    result = evaluate(
+        "shipgym/RVGPathFollowing-v0",
+        policy,
+        "classic",
+        1,
+        0,
+        reset_options=options,
+        progress=_quiet,
+    )
+    log = result.logs[0]
+    return np.asarray(log.time), log.signal("cross_track_error")
+
+
+def test_los_conditional_integrator_removes_the_cross_track_error_in_current() -> None:
+    t, e = _straight_run(integral=True)
+    steady = np.abs(e[t > t[-1] - 150.0])
+    assert steady.mean() < 0.5
+    assert steady.max() < 1.0
+    # the ablation: the same LOS without the integrator keeps a steady error
+    t0, e0 = _straight_run(integral=False)
+    steady0 = np.abs(e0[t0 > t0[-1] - 150.0])
+    assert steady0.min() > 2.0
+    # and the error it keeps is the crab-angle error of proportional LOS, e = Delta tan(beta)
+    beta = math.asin(0.5 / SERVICE_SPEED)
+    assert steady0.mean() == pytest.approx(6 * LPP * math.tan(beta), rel=0.2)
+
+
+@pytest.mark.parametrize("direction_deg", [0.0, 90.0, 180.0, 270.0])
+def test_rvg_heading_autopilot_30_deg_step_in_current(direction_deg: float) -> None:
+    step = math.radians(30.0)
+    options = {
+        "setpoints": [step],
+        "current_speed": 0.5,
+        "current_direction": math.radians(direction_deg),
+        "initial_state": {"psi": 0.0, "u": SERVICE_SPEED, "T1": 25e3, "T2": 25e3},
+    }
+    result = evaluate(
+        "shipgym/RVGHeading-v0",
+        RVGHeadingClassic(),
+        "classic",
+        1,
+        0,
+        reset_options=options,
+        progress=_quiet,
+    )
+    log = result.logs[0]
+    t = np.asarray(log.time)
+    error_deg = np.degrees(log.signal("heading_error"))  # setpoint minus heading
+    overshoot = max(0.0, -float(error_deg.min()))
+    outside = np.flatnonzero(np.abs(error_deg) > 2.0)
+    settled_at = t[outside[-1] + 1] if outside.size else 0.0
+    assert overshoot < 5.0
+    assert settled_at < 120.0
+
+
+def test_target_tracking_closes_and_holds_the_distance() -> None:
+    options = {
+        "target_position": [500.0, 400.0],
+        "target_velocity": [0.0, 2.0],  # east at 2 m/s
+        "distance": 50.0,
+        "current_speed": 0.3,
+        "current_direction": math.radians(45.0),
+        "initial_state": {"psi": 0.0, "u": SERVICE_SPEED, "T1": 25e3, "T2": 25e3},
+    }
+    result = evaluate(
+        "shipgym/RVGTargetTracking-v0",
+        RVGTargetClassic(),
+        "classic",
+        1,
+        0,
+        reset_options=options,
+        progress=_quiet,
+    )
+    log = result.logs[0]
+    t = np.asarray(log.time)
+    distance = log.signal("distance")
+    assert distance[0] > 500.0
+    intercept = result.per_episode[0]["time_to_intercept_s"]
+    assert intercept < 500.0  # 640 m away, closing at about 1.5 m/s
+    held = distance[t > intercept + 100.0]
+    assert held.size > 100
+    assert np.all(np.abs(held - 50.0) < 5.0)  # within 10 % of the set distance
+    assert distance.min() > 25.0  # never on a collision course
+
+
+#: For each env: (metric, classic must be below this fraction of zero's value).
+_MARGIN = {
+    "shipgym/NomotoHeading-v0": ("heading_rms_deg", 0.7),
+    "shipgym/RVGHeading-v0": ("heading_rms_deg", 0.5),
+    "shipgym/RVGSpeed-v0": ("speed_rms_m_s", 0.5),
+    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", 0.7),
+    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", 0.3),
+}
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_classic_beats_zero_by_a_wide_margin(env_id: str) -> None:
+    classic = evaluate(env_id, make_policy("classic", env_id), "classic", 3, 500, progress=_quiet)
+    zero = evaluate(env_id, make_policy("zero", env_id), "zero", 3, 500, progress=_quiet)
+    metric, fraction = _MARGIN[env_id]
+    assert classic.metrics[metric] < fraction * zero.metrics[metric]
+    c, z = classic.to_dict(), zero.to_dict()
+    assert c["mean_return"] > z["mean_return"] + 2 * max(c["std_return"], 1.0)
+    if env_id == "shipgym/RVGPathFollowing-v0":
+        assert classic.metrics["completed"] > zero.metrics["completed"]
+
+
+def test_same_seeds_give_every_controller_the_same_scenarios() -> None:
+    env_id = "shipgym/RVGPathFollowing-v0"
+    a = evaluate(env_id, make_policy("classic", env_id), "classic", 2, 7, progress=_quiet)
+    b = evaluate(env_id, make_policy("zero", env_id), "zero", 2, 7, progress=_quiet)
+    for la, lb in zip(a.logs, b.logs, strict=True):
+        assert np.array_equal(la.extras["waypoints"], lb.extras["waypoints"])
+        assert la.reset_info["current_speed"] == lb.reset_info["current_speed"]
+        assert np.array_equal(la.reset_info["state"], lb.reset_info["state"])
+
+
+def test_evaluate_command_writes_json_and_plots(tmp_path: Path) -> None:
+    out = tmp_path / "eval.json"
+    plots = tmp_path / "plots"
+    code = main(
+        [
+            "evaluate",
+            "--env",
+            "shipgym/RVGSpeed-v0",
+            "--controller",
+            "classic",
+            "--episodes",
+            "2",
+            "--seed",
+            "3",
+            "--json",
+            str(out),
+            "--plot",
+            str(plots),
+        ]
+    )
+    assert code == 0
+    summary = json.loads(out.read_text())
+    assert summary["env"] == "shipgym/RVGSpeed-v0"
+    assert summary["controller"] == "classic"
+    assert summary["episodes"] == 2
+    assert set(summary) >= {"mean_return", "std_return", "metrics"}
+    assert set(summary["metrics"]) == {"speed_rms_m_s"}
+    assert len(list(plots.glob("*.png"))) == 2
+
+
+def test_evaluate_rejects_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["evaluate", "--env", "shipgym/RVGSpeed-v0", "--controller", "pid"]) == 2
+    assert "pid" in capsys.readouterr().err
+    assert main(["evaluate", "--env", "nope", "--episodes", "1"]) == 2
+    with pytest.raises(ValueError, match="episodes"):
+        evaluate("shipgym/RVGSpeed-v0", make_policy("zero", "shipgym/RVGSpeed-v0"), "zero", 0)
+    with pytest.raises(ValueError, match="unknown controller"):
+        make_policy("ppo", "shipgym/RVGSpeed-v0")
