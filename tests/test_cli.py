@@ -9,11 +9,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from shipgym.cli import SUBCOMMANDS, main
-from shipgym.demo import zigzag
 from shipgym.envs import ENV_IDS
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -45,31 +43,6 @@ def test_demo_writes_figures_and_plausible_summary(tmp_path: Path, capsys) -> No
     assert re.search(r"completed yes", stdout), stdout
     mean_e = float(re.search(r"mean \|cross-track\| ([\d.]+) m", stdout).group(1))
     assert 0.0 < mean_e < 30.0
-
-
-def test_zigzag_switches_at_the_check_heading_and_measures_the_peaks() -> None:
-    zz = zigzag("nomoto1", angle_deg=20.0, dt=0.1)
-    res = zz.result
-    psi = np.degrees(res["psi"])
-    r_max = np.degrees(np.abs(res["r"]).max())
-    for k, t_rev in enumerate(zz.reversal_times):
-        i = int(np.searchsorted(res.time, t_rev))
-        check = 20.0 if k % 2 == 0 else -20.0
-        # the pilot reverses at the first sample past the check heading
-        assert abs(psi[i] - check) <= r_max * 0.1 + 1e-9
-        assert np.sign(res["delta_c"][i]) == -np.sign(check)
-    for k, (ov, tp) in enumerate(zip(zz.overshoots_deg, zz.overshoot_times, strict=True)):
-        window = (res.time >= zz.reversal_times[k]) & (res.time <= zz.reversal_times[k + 1])
-        extreme = psi[window].max() if k % 2 == 0 else -psi[window].min()
-        assert ov == pytest.approx(extreme - 20.0)
-        # at the peak the yaw rate changes sign
-        j = int(np.searchsorted(res.time, tp))
-        assert abs(np.degrees(res["r"][j])) < 0.05
-
-
-def test_zigzag_of_the_nonlinear_bech_model_has_small_overshoots() -> None:
-    zz = zigzag("bech")
-    assert all(0.0 < ov < 30.0 for ov in zz.overshoots_deg[:2])
 
 
 def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:

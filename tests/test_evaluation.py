@@ -15,10 +15,15 @@ import numpy as np
 import pytest
 
 from shipgym.benchmark import evaluate, make_policy
-from shipgym.benchmark.policies import RVGHeadingClassic, RVGPathClassic, RVGTargetClassic
+from shipgym.benchmark.policies import (
+    RVG_LOOKAHEAD,
+    RVGHeadingClassic,
+    RVGPathClassic,
+    RVGTargetClassic,
+)
 from shipgym.cli import main
 from shipgym.envs import ENV_IDS
-from shipgym.models.rvg import LPP, SERVICE_SPEED
+from shipgym.models.rvg import SERVICE_SPEED
 
 
 def _quiet(line: str) -> None:
@@ -33,8 +38,7 @@ def _straight_run(integral: bool) -> tuple[np.ndarray, np.ndarray]:
         "current_direction": math.pi / 2,
         "initial_state": {"psi": 0.0, "u": SERVICE_SPEED, "T1": 25e3, "T2": 25e3},
     }
-    # lookahead 6 L: the LOS loop (bandwidth U / Delta) well below the heading loop
-    policy = RVGPathClassic(integral=integral, lookahead=6 * LPP)
+    policy = RVGPathClassic(integral=integral)  # the classic controller, lookahead 3 L
     result = evaluate(
         "shipgym/RVGPathFollowing-v0",
         policy,
@@ -59,7 +63,7 @@ def test_los_conditional_integrator_removes_the_cross_track_error_in_current() -
     assert steady0.min() > 2.0
     # and the error it keeps is the crab-angle error of proportional LOS, e = Delta tan(beta)
     beta = math.asin(0.5 / SERVICE_SPEED)
-    assert steady0.mean() == pytest.approx(6 * LPP * math.tan(beta), rel=0.2)
+    assert steady0.mean() == pytest.approx(RVG_LOOKAHEAD * math.tan(beta), rel=0.05)
 
 
 @pytest.mark.parametrize("direction_deg", [0.0, 90.0, 180.0, 270.0])

@@ -36,10 +36,15 @@ from controllers.paths import WaypointPath
 from shipgym.models import make_model
 from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEED
 
-#: Gunnerus heading autopilot settings (``controllers.heading`` module docstring).
+#: Gunnerus heading autopilot: closed-loop bandwidth [rad/s] of the pole placement.
 RVG_OMEGA_N = 0.3
-RVG_REFERENCE_OMEGA = 0.1
-RVG_MAX_TURN_RATE = 0.03
+#: Reference model (frequency [rad/s], turn-rate limit [rad/s]) for setpoint steps: slow
+#: enough that a 30-90 deg step never overshoots (the ship is directionally unstable).
+RVG_STEP_REFERENCE = (0.1, 0.03)
+#: Reference model for LOS guidance, whose setpoints move smoothly: faster, so the heading
+#: loop stays well inside the guidance loop. (Target tracking keeps the step reference: its
+#: course-to-heading conversion uses the measured sideslip, which a fast loop excites.)
+RVG_GUIDANCE_REFERENCE = (0.3, 0.04)
 #: LOS lookahead for the Gunnerus: three ship lengths.
 RVG_LOOKAHEAD = 3.0 * LPP
 
@@ -68,7 +73,9 @@ def rvg_heading_nomoto(speed: float = SERVICE_SPEED) -> tuple[float, float]:
     return float(yaw_accel_per_azimuth * T), T
 
 
-def _rvg_heading_autopilot(dt: float, max_azimuth: float) -> HeadingAutopilot:
+def _rvg_heading_autopilot(
+    dt: float, max_azimuth: float, reference: tuple[float, float]
+) -> HeadingAutopilot:
     K, T = rvg_heading_nomoto()
     params = make_model("rvg3dof").params
     return HeadingAutopilot.from_nomoto(
@@ -76,8 +83,8 @@ def _rvg_heading_autopilot(dt: float, max_azimuth: float) -> HeadingAutopilot:
         T,
         dt,
         omega_n=RVG_OMEGA_N,
-        reference_omega=RVG_REFERENCE_OMEGA,
-        max_turn_rate=RVG_MAX_TURN_RATE,
+        reference_omega=reference[0],
+        max_turn_rate=reference[1],
         max_command=max_azimuth,
         max_rate=params.azimuth_max_rate,
         actuator_time_constant=params.azimuth_time_constant,
@@ -153,7 +160,7 @@ class RVGHeadingClassic:
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         self.dt = env.dt
         self.max_azimuth = env.task.max_azimuth
-        self.pilot = _rvg_heading_autopilot(env.dt, env.task.max_azimuth)
+        self.pilot = _rvg_heading_autopilot(env.dt, env.task.max_azimuth, RVG_STEP_REFERENCE)
         state = info["state"]
         self.pilot.reset(state[2], state[IR], t=0.0)
         self.t = 0.0
@@ -204,7 +211,7 @@ class RVGPathClassic:
             switching="circle",
             acceptance_radius=task.accept_radius,
         )
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth)
+        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, RVG_GUIDANCE_REFERENCE)
         self.speed = _rvg_speed_autopilot(env.dt)
         state = info["state"]
         self.heading.reset(state[2], state[IR], t=0.0)
@@ -235,7 +242,7 @@ class RVGTargetClassic:
         self.guidance = ConstantBearingGuidance(
             2.0, 100.0, float(task.distance[0]), max_speed=6.0, dt=env.dt
         )
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth)
+        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, RVG_STEP_REFERENCE)
         self.speed = _rvg_speed_autopilot(env.dt, design_speed=3.0)
         state = info["state"]
         self.heading.reset(state[2], state[IR], t=0.0)
