@@ -635,7 +635,9 @@ class HeadingAutopilot:
             u_applied = -self.kd * (r - r_lim) + self.offset
         if self.nomoto_feedforward and self.nomoto is not None:
             K, T = self.nomoto
-            u += (T * a_d + r_d) / K
+            feedforward = (T * a_d + r_d) / K
+            u += feedforward
+            u_applied += feedforward
         u_lim = min(max(u_applied, -self.max_command), self.max_command)
         if math.isfinite(self.max_rate) and math.isfinite(self.command):
             step = self.max_rate * h

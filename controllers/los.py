@@ -62,35 +62,10 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from controllers._angles import nonnegative, positive, ssa
 from controllers.paths import Path, WaypointPath
 
 __all__ = ["IntegralLOS", "LOSGuidance"]
-
-
-def _ssa(angle: float) -> float:
-    """Smallest signed angle: wrap ``angle`` [rad] to ``[-pi, pi)``."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def _positive(name: str, value: float, *, allow_inf: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a positive number, got {value!r}") from exc
-    if not (v > 0.0 and (math.isfinite(v) or (allow_inf and v == math.inf))):
-        what = "positive" if allow_inf else "positive and finite"
-        raise ValueError(f"{name} must be {what}, got {value!r}")
-    return v
-
-
-def _nonnegative(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be a number >= 0, got {value!r}") from exc
-    if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
-    return v
 
 
 class _LOSBase:
@@ -112,12 +87,12 @@ class _LOSBase:
         if switching not in ("circle", "along_track"):
             raise ValueError(f"switching must be 'circle' or 'along_track', got {switching!r}")
         self.path = path
-        self.lookahead = _positive("lookahead", lookahead)
+        self.lookahead = positive("lookahead", lookahead)
         self.switching = switching
         self.acceptance_radius = (
             self.lookahead
             if acceptance_radius is None
-            else _positive("acceptance_radius", acceptance_radius)
+            else positive("acceptance_radius", acceptance_radius)
         )
         self._is_waypoint = isinstance(path, WaypointPath)
         if self._is_waypoint:
@@ -231,7 +206,7 @@ class _LOSBase:
         else:
             self._locate_continuous(p)
         self._chi_r = self._correction(self._e, rr, dt)
-        self._chi_d = _ssa(self._chi_p + self._chi_r)
+        self._chi_d = ssa(self._chi_p + self._chi_r)
         return self._chi_d
 
     __call__ = update
@@ -358,20 +333,20 @@ class LOSGuidance(_LOSBase):
         switching: str = "along_track",
         acceptance_radius: float | None = None,
     ) -> None:
-        delta = _positive("lookahead", lookahead)
-        self.design_speed = _positive("design_speed", design_speed)
-        self.ki = self.design_speed / (4.0 * delta**2) if ki is None else _nonnegative("ki", ki)
-        self.r_lim = _positive("r_lim", r_lim, allow_inf=True)
-        self.e_lim = delta if e_lim is None else _positive("e_lim", e_lim, allow_inf=True)
-        self.i_max = _positive("i_max", i_max)
-        self.k1 = _nonnegative("k1", k1)
-        self.k2 = _nonnegative("k2", k2)
+        delta = positive("lookahead", lookahead)
+        self.design_speed = positive("design_speed", design_speed)
+        self.ki = self.design_speed / (4.0 * delta**2) if ki is None else nonnegative("ki", ki)
+        self.r_lim = positive("r_lim", r_lim, allow_inf=True)
+        self.e_lim = delta if e_lim is None else positive("e_lim", e_lim, allow_inf=True)
+        self.i_max = positive("i_max", i_max)
+        self.k1 = nonnegative("k1", k1)
+        self.k2 = nonnegative("k2", k2)
         if self.k1 + self.k2 < 1.0:
             raise ValueError(
                 f"k1 + k2 must be >= 1 so that the soft saturation slows the integrator, got "
                 f"k1={k1!r}, k2={k2!r}"
             )
-        self.i_hard = 2.0 * self.i_max if i_hard is None else _positive("i_hard", i_hard)
+        self.i_hard = 2.0 * self.i_max if i_hard is None else positive("i_hard", i_hard)
         if self.i_hard < self.i_max:
             raise ValueError(f"i_hard must be >= i_max = {self.i_max!r}, got {i_hard!r}")
         if not isinstance(integral, bool | np.bool_):
@@ -454,8 +429,8 @@ class IntegralLOS(_LOSBase):
         switching: str = "along_track",
         acceptance_radius: float | None = None,
     ) -> None:
-        self.design_speed = _positive("design_speed", design_speed)
-        self.sigma = 0.25 * self.design_speed if sigma is None else _nonnegative("sigma", sigma)
+        self.design_speed = positive("design_speed", design_speed)
+        self.sigma = 0.25 * self.design_speed if sigma is None else nonnegative("sigma", sigma)
         super().__init__(path, lookahead, switching=switching, acceptance_radius=acceptance_radius)
 
     @property

@@ -38,6 +38,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
+from controllers._angles import ssa_array
+
 __all__ = ["FilletPath", "Path", "SplinePath", "WaypointPath"]
 
 FloatArray = npt.NDArray[np.float64]
@@ -47,11 +49,6 @@ _TWO_PI = 2.0 * math.pi
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GL_X = 0.5 * (_GL_X + 1.0)
 _GL_W = 0.5 * _GL_W
-
-
-def _ssa(angle: npt.ArrayLike) -> FloatArray:
-    """Smallest signed angle: wrap ``angle`` [rad] to ``[-pi, pi)``."""
-    return np.mod(np.asarray(angle, dtype=np.float64) + math.pi, _TWO_PI) - math.pi
 
 
 def _validate_waypoints(waypoints: npt.ArrayLike) -> FloatArray:
@@ -354,7 +351,7 @@ class _PiecewisePath(Path):
         s_arr = self._check_s(s)
         k = self._piece(s_arr)
         _, chi = self._eval(k, s_arr - self._s0[k])
-        out = _ssa(chi)
+        out = ssa_array(chi)
         return float(out) if out.ndim == 0 else out
 
     def curvature(self, s: npt.ArrayLike) -> FloatArray | float:
@@ -489,7 +486,7 @@ class FilletPath(_PiecewisePath):
         legs = np.hypot(diff[:, 0], diff[:, 1])
         chi = np.arctan2(diff[:, 1], diff[:, 0])
         theta = np.zeros(len(wp))  # course change at each waypoint (0 at both ends)
-        theta[1:-1] = _ssa(chi[1:] - chi[:-1])
+        theta[1:-1] = ssa_array(chi[1:] - chi[:-1])
         for i in range(1, len(wp) - 1):
             if abs(abs(theta[i]) - math.pi) < 1e-9:
                 raise ValueError(
@@ -673,7 +670,7 @@ class SplinePath(Path):
     def tangent_angle(self, s: npt.ArrayLike) -> FloatArray | float:
         u = self._u_of_s(self._check_s(s))
         d = self._direction(u)
-        out = _ssa(np.arctan2(d[..., 1], d[..., 0]))
+        out = ssa_array(np.arctan2(d[..., 1], d[..., 0]))
         return float(out) if out.ndim == 0 else out
 
     def curvature(self, s: npt.ArrayLike) -> FloatArray | float:

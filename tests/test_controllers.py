@@ -762,3 +762,30 @@ def test_controllers_do_not_import_shipgym() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_turn_rate_limit_bounds_the_implied_yaw_rate_demand() -> None:
+    """With ``max_turn_rate`` the PID acts as a cascade whose yaw-rate demand is clipped."""
+    K, T = 0.076, -5.57  # the Gunnerus, unstable
+    pilot = HeadingAutopilot.from_nomoto(
+        K, T, 0.5, omega_n=0.3, reference_omega=0.3, max_turn_rate=0.02
+    )
+    free = HeadingAutopilot.from_nomoto(K, T, 0.5, omega_n=0.3, reference_omega=0.3)
+    pilot.reset(0.0, 0.0, t=0.0)
+    free.reset(0.0, 0.0, t=0.0)
+    for k in range(1, 40):  # a 90 deg setpoint: the heading error grows large
+        u = pilot.update(0.5 * k, 0.0, 0.0, math.radians(90.0))
+        u_free = free.update(0.5 * k, 0.0, 0.0, math.radians(90.0))
+    # the ship does not turn (r = 0): the clipped demand is at most 0.02 rad/s
+    assert abs(u) == pytest.approx(abs(pilot.kd) * 0.02, rel=1e-9)
+    assert abs(u_free) > 3 * abs(u)
+    # below the limit the two laws are the same PID
+    small = HeadingAutopilot.from_nomoto(
+        K, T, 0.5, omega_n=0.3, reference_omega=0.3, max_turn_rate=0.02
+    )
+    small_free = HeadingAutopilot.from_nomoto(K, T, 0.5, omega_n=0.3, reference_omega=0.3)
+    small.reset(0.0, 0.0, t=0.0)
+    small_free.reset(0.0, 0.0, t=0.0)
+    a = small.update(0.5, 0.0, 0.0, math.radians(0.5))
+    b = small_free.update(0.5, 0.0, 0.0, math.radians(0.5))
+    assert a == pytest.approx(b, rel=1e-12)
