@@ -1,6 +1,10 @@
 """System identification from measured manoeuvring data (issue 4).
 
-``shipgym.sysid.data``: the canonical :class:`Record` and the loaders of the measured sources.
+* ``shipgym.sysid.data``: the canonical :class:`Record` and the loaders of the measured sources.
+* ``shipgym.sysid.fit``: equation-error and output-error fits of the Nomoto-family models with
+  standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
+* ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive
+  backstepping identifier of seed 002.
 """
 
 from shipgym.sysid.data import (
@@ -12,13 +16,21 @@ from shipgym.sysid.data import (
     load,
     load_all,
 )
+from shipgym.sysid.fit import FitResult, fit_equation_error, fit_output_error
+from shipgym.sysid.recursive import BacksteppingIdentifier, RecursiveLeastSquares, run_rls
 
 __all__ = [
     "FORMATS",
+    "BacksteppingIdentifier",
+    "FitResult",
     "Record",
+    "RecursiveLeastSquares",
     "SysidDataWarning",
     "derive_yaw_rate",
     "detect_format",
+    "fit_equation_error",
+    "fit_output_error",
     "load",
     "load_all",
+    "run_rls",
 ]
