@@ -5,6 +5,8 @@
   standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
 * ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive
   backstepping identifier of seed 002.
+* ``shipgym.sysid.generator``: synthetic records with one undeclared effect of the catalogue,
+  the known truth for testing identification.
 """
 
 from shipgym.sysid.data import (
@@ -17,9 +19,11 @@ from shipgym.sysid.data import (
     load_all,
 )
 from shipgym.sysid.fit import FitResult, fit_equation_error, fit_output_error
+from shipgym.sysid.generator import EFFECTS, generate_record
 from shipgym.sysid.recursive import BacksteppingIdentifier, RecursiveLeastSquares, run_rls
 
 __all__ = [
+    "EFFECTS",
     "FORMATS",
     "BacksteppingIdentifier",
     "FitResult",
@@ -30,6 +34,7 @@ __all__ = [
     "detect_format",
     "fit_equation_error",
     "fit_output_error",
+    "generate_record",
     "load",
     "load_all",
     "run_rls",
