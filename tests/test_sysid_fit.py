@@ -248,3 +248,15 @@ def test_backstepping_turning_test_eq7():
     sim = replay("norrbin", res.params, t, d, x0)
     assert np.sqrt(np.mean((sim[:, 4] - rd) ** 2)) < 0.06 * np.max(np.abs(rd))
     assert res.params.K > 0
+
+
+def test_nomoto2_fit_with_a_rudder_offset_estimates_it() -> None:
+    """Regression: a bias term on the second-order model used to crash the parameter mapping."""
+    from shipgym.sysid import generate_record
+    from shipgym.sysid.fit import fit_output_error as fit_oe
+
+    rec = generate_record("rudder_offset", maneuver="zigzag", dt=0.5, seed=0, noise=False)
+    res = fit_oe(rec.time, rec.delta, rec.psi, rec.r, "nomoto2", bias=True)
+    truth = rec.meta["truth"]["effect_params"]
+    # the generator's ship obeys T r' + r = K (delta - delta_0); the fit replays delta + delta0
+    assert res.delta0 == pytest.approx(-truth["delta_0"], rel=0.1)

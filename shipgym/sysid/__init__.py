@@ -5,6 +5,8 @@
   standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
 * ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive
   backstepping identifier of seed 002.
+* ``shipgym.sysid.effects``: residual diagnosis and the effect-catalogue loop
+  (:func:`identify`) for the Nomoto family.
 * ``shipgym.sysid.generator``: synthetic records with one undeclared effect of the catalogue,
   the known truth for testing identification.
 """
@@ -18,6 +20,7 @@ from shipgym.sysid.data import (
     load,
     load_all,
 )
+from shipgym.sysid.effects import IdentificationResult, identify, residual_diagnostics
 from shipgym.sysid.fit import FitResult, fit_equation_error, fit_output_error
 from shipgym.sysid.generator import EFFECTS, generate_record
 from shipgym.sysid.recursive import BacksteppingIdentifier, RecursiveLeastSquares, run_rls
@@ -27,6 +30,7 @@ __all__ = [
     "FORMATS",
     "BacksteppingIdentifier",
     "FitResult",
+    "IdentificationResult",
     "Record",
     "RecursiveLeastSquares",
     "SysidDataWarning",
@@ -35,7 +39,9 @@ __all__ = [
     "fit_equation_error",
     "fit_output_error",
     "generate_record",
+    "identify",
     "load",
     "load_all",
+    "residual_diagnostics",
     "run_rls",
 ]

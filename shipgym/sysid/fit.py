@@ -505,9 +505,10 @@ def regression_to_params(
     T3 = c["delta_dot"] / c["delta"]
     if model == "nomoto2":
         values = {"K": K, "T1": T1, "T2": T2, "T3": T3}
+        params = Nomoto2Params(**values)
         if "1" in c:
             values["delta0"] = bias / c["delta"]
-        return Nomoto2Params(**values), values
+        return params, values
     sgn = -math.copysign(1.0, lin)  # K b1
     values = {
         "K": K,

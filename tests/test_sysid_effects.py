@@ -1,0 +1,117 @@
+"""Tests of the closing-the-loop identifier (shipgym.sysid.effects) on generated records."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from shipgym.sysid.data import Record
+from shipgym.sysid.effects import CATALOGUE, identify
+from shipgym.sysid.generator import EFFECTS, generate_record
+
+DT = 0.5
+DURATION = 600.0
+
+
+def _record(effect: str | None, maneuver: str = "zigzag", seed: int = 0) -> Record:
+    return generate_record(effect, maneuver=maneuver, dt=DT, duration=DURATION, seed=seed)
+
+
+def test_catalogue_matches_generator() -> None:
+    assert set(CATALOGUE) == set(EFFECTS)
+
+
+@pytest.mark.parametrize("maneuver", ["zigzag", "random"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_clean_record_gets_no_effect(maneuver: str, seed: int) -> None:
+    res = identify(_record(None, maneuver, seed))
+    assert res.effects == []
+    assert res.error_after == res.error_before
+    # base fit at the noise level (0.1 deg heading noise, 0.02 deg/s yaw-rate noise)
+    assert res.error_before["psi_rms_deg"] < 0.2
+    assert res.error_before["r_rms_deg_s"] < 0.03
+    assert abs(res.parameters_after["K"] - 0.185) < 0.01
+    assert abs(res.parameters_after["T"] - 107.3) < 5.0
+
+
+@pytest.mark.parametrize(
+    "effect", ["rudder_offset", "yaw_nonlinearity", "rudder_lag", "input_delay", "second_order"]
+)
+def test_yaw_effect_is_named_first_and_halves_the_error(effect: str) -> None:
+    res = identify(_record(effect))
+    assert res.effects, f"no effect found; rounds: {res.rounds}"
+    assert res.effects[0]["name"] == effect, res.rounds[0]
+    assert res.error_after["psi_rms_deg"] <= 0.5 * res.error_before["psi_rms_deg"]
+    ev = res.effects[0]["evidence"]
+    assert ev["delta_J"] < 0
+    assert ev["heldout_psi_rms_deg_after"] < ev["heldout_psi_rms_deg_before"]
+
+
+def test_effect_parameters_close_to_truth() -> None:
+    rec = _record("input_delay")
+    res = identify(rec, max_effects=1)
+    assert res.effect_names == ["input_delay"]
+    assert abs(res.effects[0]["parameters"]["tau"] - 3.0) < 0.75
+    rec = _record("rudder_offset")
+    res = identify(rec, max_effects=1)
+    # delta0 is the rudder ADDED to the record: the truth needs -2 deg
+    assert math.degrees(res.parameters_after["delta0"]) == pytest.approx(-2.0, abs=0.2)
+
+
+def test_current_named_with_positions() -> None:
+    rec = _record("current")
+    res = identify(rec)
+    assert res.effect_names == ["current"]
+    truth = rec.meta["truth"]["effect_params"]
+    p = res.effects[0]["parameters"]
+    assert p["V_n"] == pytest.approx(truth["V_n"], abs=0.05)
+    assert p["V_e"] == pytest.approx(truth["V_e"], abs=0.05)
+    assert res.error_after["xy_rms_m"] <= 0.5 * res.error_before["xy_rms_m"]
+
+
+def test_current_needs_positions() -> None:
+    rec = _record("current")
+    no_xy = Record(time=rec.time, delta=rec.delta, psi=rec.psi, r=rec.r, U=rec.U)
+    res = identify(no_xy)
+    assert "current" not in res.effect_names
+    assert "xy_rms_m" not in res.error_before
+
+
+def test_diagnostics_report_whiteness_and_signatures() -> None:
+    clean = identify(_record(None))
+    lagged = identify(_record("input_delay"), max_effects=0)
+    q_clean = clean.diagnostics["base"]["ljung_box"]
+    q_lag = lagged.diagnostics["base"]["ljung_box"]
+    # white residual: Q ~ chi2(20) (mean 20); a missing delay colours the residual strongly
+    assert q_clean < 60.0
+    assert q_lag > 10.0 * q_clean
+    sig = lagged.diagnostics["base"]["signatures"]
+    # the phase-lag signatures explain part of the residual, offset and cubic term none of it
+    assert sig["input_delay"]["r2"] > 0.1
+    assert sig["input_delay"]["r2"] > 5.0 * sig["rudder_offset"]["r2"]
+    assert sig["input_delay"]["r2"] > 5.0 * sig["yaw_nonlinearity"]["r2"]
+    # the residual of a delayed ship is correlated with the rudder, the clean one is not
+    assert abs(lagged.diagnostics["base"]["xcorr_delta"][0]) > 0.2
+    assert abs(clean.diagnostics["base"]["xcorr_delta"][0]) < 0.1
+    assert lagged.effects == []
+    assert set(lagged.diagnostics["base"]["xcorr_delta"]) >= {0, 5}
+
+
+def test_progress_and_validation() -> None:
+    msgs: list[str] = []
+    rec = _record(None)
+    identify(rec, max_effects=1, progress=msgs.append)
+    assert msgs and msgs[0].startswith("base nomoto1")
+    with pytest.raises(ValueError, match="holdout"):
+        identify(rec, holdout=0.9)
+    with pytest.raises(ValueError, match="base"):
+        identify(rec, base="bech")
+    with pytest.raises(ValueError, match="max_effects"):
+        identify(rec, max_effects=-1)
+    with pytest.raises(ValueError, match="Record"):
+        identify(np.zeros(3))  # type: ignore[arg-type]
+    short = Record(time=rec.time[:50], delta=rec.delta[:50], psi=rec.psi[:50], r=rec.r[:50])
+    with pytest.raises(ValueError, match="too short"):
+        identify(short)
