@@ -79,7 +79,7 @@ from shipgym.models import (
 from shipgym.models._jit import kernel
 from shipgym.models.base import MODEL_NAMES
 from shipgym.models.integrate import rk4_row
-from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, pack_nomoto
+from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
 
 __all__ = [
     "FIT_MODELS",
@@ -918,15 +918,9 @@ def fit_output_error(
 
     h, _, n_cmd = _replay_inputs(t, delta, speed)
     out = np.empty((n, nx))
-    head = np.array(
-        [
-            _REPLAY_GEAR.max_angle,
-            _REPLAY_GEAR.max_rate,
-            _REPLAY_GEAR.time_constant,
-            _REPLAY_SURGE.gain,
-            _REPLAY_SURGE.time_constant,
-        ]
-    )
+    # actuator/surge head of the parameter vector (layout owned by ``pack_nomoto``); the yaw
+    # coefficients follow, unvalidated, since the optimiser may probe any values
+    head = pack_nomoto(cls(), _REPLAY_GEAR, _REPLAY_SURGE)[:P_YAW]
 
     def simulate(theta: np.ndarray) -> np.ndarray:
         vals, x, d0 = unpack(theta)
