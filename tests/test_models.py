@@ -355,6 +355,54 @@ def test_rvg_pod_forces_at_rest_follow_eq20() -> None:
     assert model.deriv(x, [50e3, 0.0, 0.0, 0.0])[0, 5] > 0.0
 
 
+def test_rvg_pod_lift_adds_the_foil_side_force_at_each_pod() -> None:
+    """With ``c_L > 0`` the derivative differs from seed 001's by ``M^-1 [0, L, x_t L]`` summed
+    over the pods, ``L = c_L u_r |u_r| sin(alpha)``, and the lift turns the ship the same way as
+    the thrust's side component (positive azimuth: to port)."""
+    c_l = 6.5e3
+    base = make_model("rvg3dof", RVGParams())
+    lift = make_model("rvg3dof", RVGParams(pod_lift_coefficient=c_l))
+    params = lift.params
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        u, v, r = rng.uniform(-2, 6), rng.uniform(-1, 1), rng.uniform(-0.05, 0.05)
+        alpha = rng.uniform(-0.6, 0.6, 2)
+        x = np.array([0.0, 0.0, 0.3, u, v, r, 30e3, 30e3, *alpha])
+        inputs = [30e3, 30e3, *alpha]
+        diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
+        force = np.zeros(3)
+        for k in range(2):
+            side = c_l * u * abs(u) * math.sin(alpha[k])
+            force += np.array([0.0, side, params.pod_x[k] * side])
+        np.testing.assert_allclose(params.mass_matrix @ diff, force, rtol=1e-9, atol=1e-6)
+    x = np.array([0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 30e3, 30e3, 0.1, 0.1])
+    r_dot_base = base.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
+    r_dot_lift = lift.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
+    assert r_dot_lift < r_dot_base < 0.0
+
+
+def test_rvg_pod_thrust_follows_the_kongsberg_bollard_table_and_the_thrust_limit() -> None:
+    """The propeller law reproduces the bollard thrusts of RVG_PARAMETERS.md (68.5 / 98.6 /
+    121.7 / 147.3 kN at 150 / 180 / 200 / 220 rpm) and equals the speed-dependent thrust limit
+    at the reference 200 rpm; the documented lift coefficient reproduces the 34.3 kN side force
+    at 5 m/s, 180 rpm, 10 deg."""
+    from shipgym.models.rvg import POD_LIFT_COEFFICIENT_THRUSTER_DATA, pack_rvg, pod_thrust
+
+    params = RVGParams()
+    p = pack_rvg(params)
+    table = {150: 68.5e3, 180: 98.6e3, 200: 121.7e3, 220: 147.3e3}
+    for rpm, thrust in table.items():
+        assert pod_thrust(float(rpm), 0.0, p) == pytest.approx(thrust, rel=2e-3)
+    for ur in (0.0, 2.0, 5.0, 8.0):
+        assert pod_thrust(200.0, ur, p) == pytest.approx(params.max_thrust(ur), rel=1e-12)
+    assert pod_thrust(100.0, 20.0, p) == 0.0
+    a = math.radians(10.0)
+    side = pod_thrust(180.0, 5.0, p) * math.sin(a) + POD_LIFT_COEFFICIENT_THRUSTER_DATA * 25.0 * (
+        math.sin(a)
+    )
+    assert side == pytest.approx(34.3e3, rel=1e-9)
+
+
 def test_current_direction_convention() -> None:
     """``direction`` is where the water goes, clockwise from north: pi/2 moves it east."""
     north, east = Current(2.0, math.pi / 2).ned

@@ -18,7 +18,19 @@ Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`
 ``alpha' = sat_rate((sat(alpha_c) - alpha) / tau_alpha)``; each pod at ``(x_t, y_t)`` gives
 ``F = T [cos a, sin a, -y_t cos a + x_t sin a]``, so positive azimuth on aft pods turns the ship
 to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
-200 rpm (RVG_PARAMETERS.md). Foil lift of the pods is not in eq. 19 and is not modelled here.
+200 rpm (RVG_PARAMETERS.md).
+
+Pod foil lift (the "rudder" loads that seed 001 says eq. 19 leaves out): each pod adds a side
+force ``L = c_L u_r |u_r| sin(alpha)`` in body ``y`` at the pod, so ``F += [0, L, x_t L]``; it
+acts with the thrust's ``T sin(alpha)`` (a foil swung to starboard meets the inflow on its port
+face). ``c_L = 0`` by default, which is seed 001's model; ``POD_LIFT_COEFFICIENT_THRUSTER_DATA``
+is the value implied by the Kongsberg pod data (34.3 kN side force at 5 m/s, 180 rpm, 10 deg, of
+which ``T sin(alpha)`` is 6.2 kN).
+
+Propeller law (:func:`pod_thrust`, used where the input is an rpm, e.g. the sea-trial replay of
+:mod:`shipgym.sysid`): ``T = T_bollard (s^2 - s u_r / u_0)`` with ``s = n / n_ref``,
+``n_ref = 200`` rpm. Its bollard values ``T_bollard s^2`` are the Kongsberg table (68.5 / 98.6 /
+121.7 / 147.3 kN at 150 / 180 / 200 / 220 rpm) and at 200 rpm it is the thrust limit above.
 
 State ``[x, y, psi, u, v, r, T_1, T_2, alpha_1, alpha_2]`` in [m, m, rad, m/s, m/s, rad/s, N, N,
 rad, rad]; input ``[T_1c, T_2c, alpha_1c, alpha_2c]``. Pod 1 is port (y < 0), pod 2 starboard.
@@ -58,6 +70,13 @@ _D_V = 0.5 * 0.5 * LPP * VERES_DRAUGHT * 1000.0  # 23 611.35, RVG_PARAMETERS.md
 #: at 10 deg and beyond what full opposite azimuth can check. The formula is not used.
 YAW_QUADRATIC_DAMPING = 3.6543e8
 YAW_QUADRATIC_DAMPING_CROSSFLOW = _D_V * LPP**3 / 32.0
+
+#: Pod foil lift coefficient [N s^2/m^2] implied by the Kongsberg pod data (RVG_PARAMETERS.md):
+#: 34.3 kN side force at u = 5 m/s, 180 rpm, 10 deg azimuth, less T sin(alpha) = 35.6 kN x
+#: sin(10 deg) from :func:`pod_thrust`, over u^2 sin(10 deg). Not in seed 001 (default 0).
+POD_LIFT_COEFFICIENT_THRUSTER_DATA = (
+    34.3e3 - 121.7e3 * (0.9**2 - 0.9 * 5.0 / 8.7) * math.sin(math.radians(10.0))
+) / (25.0 * math.sin(math.radians(10.0)))
 
 
 def _m3(rows: tuple[tuple[float, float, float], ...]) -> np.ndarray:
@@ -99,6 +118,11 @@ class RVGParams:
         Relative surge speed [m/s] where the thrust limit falls to zero (8.7 m/s).
     service_thrust : float
         Per-pod thrust [N] that holds the 10 kn service speed in calm water (25 kN).
+    pod_lift_coefficient : float
+        Foil lift ``c_L`` [N s^2/m^2] per pod; 0 (seed 001 eq. 19) by default, see
+        ``POD_LIFT_COEFFICIENT_THRUSTER_DATA``.
+    reference_rpm : float
+        Shaft speed [rpm] at which ``bollard_thrust`` is reached (200 rpm), for :func:`pod_thrust`.
     """
 
     mass: float = 574_127.69
@@ -123,6 +147,8 @@ class RVGParams:
     bollard_thrust: float = 121.7e3
     thrust_zero_speed: float = 8.7
     service_thrust: float = 25.0e3
+    pod_lift_coefficient: float = 0.0
+    reference_rpm: float = 200.0
 
     def __post_init__(self) -> None:
         for name in ("added_mass", "linear_damping"):
@@ -141,10 +167,16 @@ class RVGParams:
             "azimuth_max",
             "bollard_thrust",
             "thrust_zero_speed",
+            "reference_rpm",
         ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
+        if not (math.isfinite(self.pod_lift_coefficient) and self.pod_lift_coefficient >= 0):
+            raise ValueError(
+                "RVGParams.pod_lift_coefficient must be a finite number >= 0, got "
+                f"{self.pod_lift_coefficient!r}"
+            )
 
     @property
     def rigid_body_mass(self) -> np.ndarray:
@@ -176,7 +208,8 @@ P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = (
     44,
     45,
 )  # 1/x saves divisions
-P_SIZE = 46
+P_LIFT, P_INV_NREF = 46, 47
+P_SIZE = 48
 
 
 def pack_rvg(params: RVGParams) -> np.ndarray:
@@ -202,7 +235,19 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_AMAX] = params.azimuth_max
     p[P_TBOLL] = params.bollard_thrust
     p[P_INV_U0] = 1.0 / params.thrust_zero_speed
+    p[P_LIFT] = params.pod_lift_coefficient
+    p[P_INV_NREF] = 1.0 / params.reference_rpm
     return p
+
+
+@row_kernel
+def pod_thrust(rpm, ur, p):
+    """Propeller law: thrust [N] of one pod at shaft speed ``rpm`` and relative surge ``ur``.
+
+    ``T = T_bollard (s^2 - s u_r / u_0)``, ``s = rpm / n_ref``, floored at 0 (module docstring).
+    """
+    s = abs(rpm) * p[P_INV_NREF]
+    return max(p[P_TBOLL] * (s * s - s * ur * p[P_INV_U0]), 0.0)
 
 
 @row_kernel
@@ -252,6 +297,11 @@ def rvg_row(x, u, p, c, out):
     fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (
         -p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2
     )
+    # pod foil lift (module docstring; zero in seed 001)
+    if p[P_LIFT] != 0.0:
+        lift = p[P_LIFT] * ur * abs(ur)
+        fy += lift * (sa1 + sa2)
+        fn += lift * (p[P_POD] * sa1 + p[P_POD + 2] * sa2)
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
     m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
     a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
