@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from shipgym.sysid.data import Record
-from shipgym.sysid.effects import CATALOGUE, identify
-from shipgym.sysid.generator import EFFECTS, generate_record
+from shipgym.sysid.effects import CATALOGUE, NOMOTO_CATALOGUE, RVG_CATALOGUE, identify
+from shipgym.sysid.generator import EFFECTS, EFFECTS_BY_BASE, generate_record
 
 DT = 0.5
 DURATION = 600.0
@@ -21,6 +21,8 @@ def _record(effect: str | None, maneuver: str = "zigzag", seed: int = 0) -> Reco
 
 def test_catalogue_matches_generator() -> None:
     assert set(CATALOGUE) == set(EFFECTS)
+    assert set(NOMOTO_CATALOGUE) == set(EFFECTS_BY_BASE["nomoto1"])
+    assert set(RVG_CATALOGUE) == set(EFFECTS_BY_BASE["rvg3dof"])
 
 
 @pytest.mark.parametrize("maneuver", ["zigzag", "random"])
@@ -107,7 +109,7 @@ def test_progress_and_validation() -> None:
     with pytest.raises(ValueError, match="holdout"):
         identify(rec, holdout=0.9)
     with pytest.raises(ValueError, match="base"):
-        identify(rec, base="bech")
+        identify(rec, base="abkowitz")
     with pytest.raises(ValueError, match="max_effects"):
         identify(rec, max_effects=-1)
     with pytest.raises(ValueError, match="Record"):

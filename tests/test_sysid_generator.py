@@ -3,6 +3,12 @@
 The generator and the output-error fitter must agree on clean records (K, T recovered), every
 yaw-side effect must make the first-order fit clearly worse, and the current must be invisible to
 the yaw fit but visible against a current-free dead-reckoning replay.
+
+R/V Gunnerus base (``base_model="rvg3dof"``): a clean record is an independent
+``ShipModel.simulate`` of its recorded commands through the propeller law, the sign conventions
+are the sea trial's (positive azimuth turns to port, ``delta = -azimuth``), and each effect
+changes the motion the way its physics predicts (offset: a port turn for ``alpha_0 > 0``; foil
+lift: faster steady turns; current: a drift of ``V_c t``).
 """
 
 from __future__ import annotations
@@ -12,13 +18,29 @@ import math
 import numpy as np
 import pytest
 
-from shipgym.models import Nomoto1Params
+from shipgym.models import Nomoto1Params, RVGParams, make_model
+from shipgym.models import rvg as rvg_model
 from shipgym.sysid.data import Record
 from shipgym.sysid.fit import fit_output_error, replay
-from shipgym.sysid.generator import EFFECT_DEFAULTS, EFFECTS, NOISE, generate_record
+from shipgym.sysid.generator import (
+    BASE_MODELS,
+    EFFECT_DEFAULTS,
+    EFFECTS,
+    EFFECTS_BY_BASE,
+    NOISE,
+    RANDOM_HOLD,
+    RANDOM_MAX_RUDDER,
+    RVG_RPM_HOLD,
+    RVG_RPM_LEVELS,
+    RVG_ZIGZAG_RPM,
+    ZIGZAG_ANGLE,
+    generate_record,
+)
 
 _BASE = Nomoto1Params()
-_YAW_EFFECTS = tuple(e for e in EFFECTS if e != "current")
+_NOMOTO_EFFECTS = EFFECTS_BY_BASE["nomoto1"]
+_RVG_EFFECTS = EFFECTS_BY_BASE["rvg3dof"]
+_YAW_EFFECTS = tuple(e for e in _NOMOTO_EFFECTS if e != "current")
 #: Smallest accepted ratio of the effect's psi residual RMS to the clean one (measured >= 7).
 _MIN_RATIO = 3.0
 
@@ -134,7 +156,7 @@ def test_second_order_truth() -> None:
     assert p["T1"] + p["T2"] - p["T3"] == pytest.approx(_BASE.T)
 
 
-@pytest.mark.parametrize("effect", [None, *EFFECTS])
+@pytest.mark.parametrize("effect", [None, *_NOMOTO_EFFECTS])
 def test_undeclared_and_reproducible(effect: str | None) -> None:
     a = generate_record(effect, maneuver="random", seed=7, dt=1.0, duration=200.0)
     b = generate_record(effect, maneuver="random", seed=7, dt=1.0, duration=200.0)
@@ -162,7 +184,7 @@ def test_undeclared_and_reproducible(effect: str | None) -> None:
         ({"dt": math.nan}, "dt"),
         ({"dt": "fast"}, "dt"),
         ({"duration": 1.0}, "duration"),
-        ({"base_model": "rvg3dof"}, "base_model"),
+        ({"base_model": "kvlcc2"}, "base_model"),
         ({"magnitude": 1.0}, "effect"),
         ({"effect": "rudder_lag", "magnitude": -1.0}, "> 0"),
         ({"effect": "current", "magnitude": math.inf}, "finite"),
@@ -180,3 +202,297 @@ def test_sampling_rate_not_multiple_of_fine_step() -> None:
     assert rec.time[1] == pytest.approx(0.25)
     assert rec.meta["truth"]["fine_step"] <= 0.1
     assert rec.meta["truth"]["effect_params"]["tau"] == pytest.approx(1.1, abs=0.05)
+
+
+# --------------------------------------------------------------------------------------------
+# R/V Gunnerus base (base_model="rvg3dof")
+# --------------------------------------------------------------------------------------------
+
+
+def _rvg(effect: str | None = None, **kwargs) -> Record:
+    return generate_record(effect, base_model="rvg3dof", **kwargs)
+
+
+def _rvg_replay(rec: Record, params: RVGParams, alpha_0: float = 0.0) -> np.ndarray:
+    """Independent simulation of a record's commands (needs dt = fine step, e.g. 0.1 s).
+
+    The propeller law turns the recorded rpm into the thrust command at every step; the pods
+    get the recorded azimuth plus ``alpha_0``.
+    """
+    truth = rec.meta["truth"]
+    assert truth["fine_step"] == pytest.approx(rec.dt)
+    model = make_model("rvg3dof", params)
+    current = np.array(truth["current"])
+
+    def controller(t: float, x: np.ndarray) -> list[float]:
+        k = round(t / rec.dt)
+        psi = x[rvg_model.IPSI]
+        u_r = x[rvg_model.IU] - (current[0] * math.cos(psi) + current[1] * math.sin(psi))
+        thrust = rvg_model.pod_thrust(rec.rpm[k], u_r, model.p)
+        alpha = rec.azimuth[k] + alpha_0
+        return [thrust, thrust, alpha, alpha]
+
+    sim = model.simulate(truth["x0"], controller, rec.dt, n_steps=rec.n - 1, current=current)
+    return sim.states
+
+
+def _held(rec: Record, seconds: float) -> np.ndarray:
+    """Samples at which both commands have been constant for at least ``seconds``."""
+    k = round(seconds / rec.dt)
+    same = (np.diff(rec.azimuth) == 0.0) & (np.diff(rec.rpm) == 0.0)
+    run = np.zeros(rec.n, dtype=int)
+    for i in range(1, rec.n):
+        run[i] = run[i - 1] + 1 if same[i - 1] else 0
+    return run >= k
+
+
+def test_effect_catalogue_per_base() -> None:
+    assert BASE_MODELS == ("nomoto1", "rvg3dof")
+    assert _RVG_EFFECTS == ("thruster_lift", "azimuth_offset", "current")
+    assert EFFECTS == (*_NOMOTO_EFFECTS, "thruster_lift", "azimuth_offset")
+    assert set(EFFECT_DEFAULTS) == set(EFFECTS)
+    assert EFFECT_DEFAULTS["thruster_lift"] == pytest.approx(6.48e3, rel=0.01)
+    assert EFFECT_DEFAULTS["azimuth_offset"] == pytest.approx(math.radians(2.0))
+
+
+@pytest.mark.parametrize("maneuver", ["zigzag", "random"])
+def test_rvg_clean_record_is_an_independent_simulation_of_its_commands(maneuver: str) -> None:
+    rec = _rvg(maneuver=maneuver, dt=0.1, duration=300.0, noise=False, seed=3)
+    states = _rvg_replay(rec, RVGParams())
+    for name, i in (("x", 0), ("y", 1), ("psi", 2), ("u", 3), ("v", 4), ("r", 5)):
+        np.testing.assert_allclose(getattr(rec, name), states[:, i], rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(rec.delta, -rec.azimuth)
+    np.testing.assert_allclose(rec.U, np.hypot(rec.u, rec.v), rtol=1e-15)
+    # the start is steady straight running at the initial rpm: the only nonzero rate is x' = u
+    truth = rec.meta["truth"]
+    model = make_model("rvg3dof", RVGParams())
+    x0 = np.array(truth["x0"])
+    thrust = rvg_model.pod_thrust(rec.rpm[0], x0[rvg_model.IU], model.p)
+    assert x0[rvg_model.IT1] == x0[rvg_model.IT2] == pytest.approx(thrust, rel=1e-12)
+    rates = model.deriv(x0, [thrust, thrust, 0.0, 0.0])[0]
+    assert rates[rvg_model.IX] == pytest.approx(x0[rvg_model.IU])
+    assert np.max(np.abs(rates[rvg_model.IY :])) < 1e-9
+    assert x0[rvg_model.IPSI] == 0.0 and x0[rvg_model.IR] == 0.0 and x0[rvg_model.IV] == 0.0
+
+
+def test_rvg_zigzag_commands_and_sign_convention() -> None:
+    rec = _rvg(noise=False)
+    assert rec.duration == pytest.approx(1200.0) and rec.dt == pytest.approx(0.5)
+    assert rec.n == 2401
+    for name in ("x", "y", "u", "v", "U", "azimuth", "rpm"):
+        assert getattr(rec, name) is not None
+    np.testing.assert_array_equal(rec.rpm, RVG_ZIGZAG_RPM)
+    assert set(np.round(np.abs(rec.azimuth), 12)) == {round(ZIGZAG_ANGLE, 12)}
+    # delta = -azimuth starts at +20 deg: a starboard turn, so the raw azimuth is negative
+    assert rec.delta[0] == pytest.approx(ZIGZAG_ANGLE) and rec.azimuth[0] < 0.0
+    # steady running at 170 rpm: the sea trial's 5.2-5.3 m/s
+    assert rec.u[0] == pytest.approx(5.25, abs=0.1)
+    first = rec.time < 10.0
+    assert np.all(rec.r[first & (rec.time > 1.0)] > 0.0)
+    # positive recorded delta (negative azimuth) turns to starboard: at the end of every phase
+    # of the zigzag the yaw rate has the sign of delta, and the heading crossed +-20 deg
+    ends = np.flatnonzero(np.diff(rec.azimuth) != 0.0)
+    assert len(ends) >= 10
+    assert np.all(np.sign(rec.r[ends]) == np.sign(rec.delta[ends]))
+    np.testing.assert_array_less(ZIGZAG_ANGLE, np.abs(rec.psi[ends + 1]) + 1e-12)
+    assert rec.meta["L"] == pytest.approx(33.9)
+    assert "Gunnerus" in rec.meta["vessel"]
+
+
+def test_rvg_random_commands() -> None:
+    rec = _rvg(maneuver="random", noise=False, seed=11)
+    assert np.max(np.abs(rec.azimuth)) <= RANDOM_MAX_RUDDER
+    assert set(rec.rpm) <= set(RVG_RPM_LEVELS)
+    assert len(set(rec.rpm)) >= 2
+    az_switch = rec.time[1:][np.diff(rec.azimuth) != 0.0]
+    rpm_switch = rec.time[1:][np.diff(rec.rpm) != 0.0]
+    assert len(az_switch) >= 15
+    # hold times (to within the sampling interval) inside the documented ranges
+    assert np.min(np.diff(az_switch)) >= RANDOM_HOLD[0] - rec.dt
+    assert np.max(np.diff(az_switch)) <= RANDOM_HOLD[1] + rec.dt
+    assert np.min(np.diff(rpm_switch)) >= RVG_RPM_HOLD[0] - rec.dt
+    assert np.max(np.diff(rpm_switch)) <= RVG_RPM_HOLD[1] + rec.dt
+    # the rpm changes make the speed vary (what separates foil lift from thrust)
+    assert np.ptp(rec.u) > 1.0
+
+
+@pytest.mark.parametrize("maneuver", ["zigzag", "random"])
+@pytest.mark.parametrize("alpha_0_deg", [2.0, -2.0])
+def test_rvg_azimuth_offset_turns_the_way_alpha_0_predicts(
+    maneuver: str, alpha_0_deg: float
+) -> None:
+    clean = _rvg(maneuver=maneuver, duration=30.0, noise=False, seed=2)
+    rec = _rvg(
+        "azimuth_offset",
+        maneuver=maneuver,
+        duration=30.0,
+        noise=False,
+        seed=2,
+        magnitude=math.radians(alpha_0_deg),
+    )
+    # same start and the same recorded commands (no offset in the record) up to the zigzag's
+    # first switch (later the closed-loop zigzag switches on the offset ship's own heading)
+    upto = rec.time <= 12.0
+    for name in ("azimuth", "delta", "rpm"):
+        np.testing.assert_array_equal(getattr(rec, name)[upto], getattr(clean, name)[upto])
+    assert rec.meta["truth"]["x0"] == clean.meta["truth"]["x0"]
+    # the pods sit alpha_0 further to port-turning azimuth: relative to the commanded ship the
+    # offset ship turns to port (r < 0) for alpha_0 > 0 and to starboard for alpha_0 < 0 (the
+    # pods slew at their rate limit for the first 2 s, then the difference builds up)
+    early = (rec.time >= 4.0) & upto
+    assert np.all(np.sign(rec.r[early] - clean.r[early]) == -np.sign(alpha_0_deg))
+
+
+def test_rvg_azimuth_offset_differs_from_clean_only_through_the_offset() -> None:
+    kwargs = {"maneuver": "random", "dt": 0.1, "duration": 300.0, "noise": False, "seed": 6}
+    clean = _rvg(**kwargs)
+    rec = _rvg("azimuth_offset", **kwargs)
+    truth = rec.meta["truth"]
+    assert truth["effect_params"] == {"alpha_0": pytest.approx(math.radians(2.0))}
+    assert truth["params"]["pod_lift_coefficient"] == 0.0
+    np.testing.assert_array_equal(rec.azimuth, clean.azimuth)
+    np.testing.assert_array_equal(rec.rpm, clean.rpm)
+    assert np.max(np.abs(rec.psi - clean.psi)) > math.radians(5.0)
+    # the clean ship driven by the recorded azimuth + alpha_0 is the offset record
+    states = _rvg_replay(rec, RVGParams(), alpha_0=math.radians(2.0))
+    np.testing.assert_allclose(rec.psi, states[:, 2], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(rec.x, states[:, 0], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(rec.u, states[:, 3], rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_rvg_thruster_lift_turns_faster_at_the_same_commands(seed: int) -> None:
+    clean = _rvg(maneuver="random", noise=False, seed=seed)
+    rec = _rvg("thruster_lift", maneuver="random", noise=False, seed=seed)
+    truth = rec.meta["truth"]
+    assert truth["params"]["pod_lift_coefficient"] == pytest.approx(
+        rvg_model.POD_LIFT_COEFFICIENT_THRUSTER_DATA
+    )
+    assert truth["effect_params"]["c_L"] == pytest.approx(6.48e3, rel=0.01)
+    np.testing.assert_array_equal(rec.azimuth, clean.azimuth)
+    np.testing.assert_array_equal(rec.rpm, clean.rpm)
+    # near-steady turns: the same azimuth (>= 10 deg) and rpm held for 30 s or more
+    steady = _held(rec, 30.0) & (np.abs(rec.azimuth) >= math.radians(10.0))
+    assert steady.sum() > 100
+    assert np.all(np.sign(rec.r[steady]) == np.sign(rec.delta[steady]))
+    both = steady & (np.sign(clean.r) == np.sign(clean.delta))
+    assert both.sum() > 50
+    assert np.all(np.abs(rec.r[both]) > 1.05 * np.abs(clean.r[both]))
+
+
+@pytest.mark.parametrize("maneuver", ["zigzag", "random"])
+def test_rvg_current_drifts_the_track_by_the_current_velocity(maneuver: str) -> None:
+    clean = _rvg(maneuver=maneuver, noise=False, seed=5)
+    rec = _rvg("current", maneuver=maneuver, noise=False, seed=5)
+    truth = rec.meta["truth"]
+    v_n, v_e = truth["current"]
+    ep = truth["effect_params"]
+    assert ep["speed"] == pytest.approx(0.5) and math.hypot(v_n, v_e) == pytest.approx(0.5)
+    assert (ep["V_n"], ep["V_e"]) == pytest.approx((v_n, v_e))
+    assert (v_n, v_e) == pytest.approx(
+        (0.5 * math.cos(ep["direction"]), 0.5 * math.sin(ep["direction"]))
+    )
+    # an irrotational current leaves the motion relative to the water unchanged (the ship
+    # starts steady in the water): the heading is the clean one and the track drifts by V_c t
+    np.testing.assert_allclose(rec.psi, clean.psi, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(rec.x - clean.x, v_n * rec.time, rtol=0, atol=1e-4)
+    np.testing.assert_allclose(rec.y - clean.y, v_e * rec.time, rtol=0, atol=1e-4)
+    assert np.hypot(rec.x - clean.x, rec.y - clean.y)[-1] == pytest.approx(600.0, rel=1e-6)
+    # the recorded u, v are over ground: the clean ones plus the body-frame current
+    u_c = v_n * np.cos(rec.psi) + v_e * np.sin(rec.psi)
+    v_c = -v_n * np.sin(rec.psi) + v_e * np.cos(rec.psi)
+    np.testing.assert_allclose(rec.u - clean.u, u_c, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(rec.v - clean.v, v_c, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("effect", [None, *_RVG_EFFECTS])
+def test_rvg_noise_on_measurements_only(effect: str | None) -> None:
+    noisy = _rvg(effect, maneuver="random", seed=4)
+    quiet = _rvg(effect, maneuver="random", seed=4, noise=False)
+    n = noisy.n
+    expected = {"psi": "psi", "r": "r", "x": "xy", "y": "xy", "u": "uv", "v": "uv"}
+    for channel, key in expected.items():
+        err = getattr(noisy, channel) - getattr(quiet, channel)
+        # sampling error of a standard deviation: 1 / sqrt(2 n), about 1.4 % here
+        assert np.std(err) == pytest.approx(NOISE[key], rel=5.0 / math.sqrt(2 * n)), channel
+        assert abs(np.mean(err)) < 5.0 * NOISE[key] / math.sqrt(n), channel
+    for channel in ("azimuth", "delta", "rpm"):
+        np.testing.assert_array_equal(getattr(noisy, channel), getattr(quiet, channel))
+    np.testing.assert_allclose(noisy.U, np.hypot(noisy.u, noisy.v), rtol=1e-15)
+    assert noisy.meta["noise"] == pytest.approx(
+        {"psi": NOISE["psi"], "r": NOISE["r"], "xy": NOISE["xy"], "uv": NOISE["uv"]}
+    )
+    assert quiet.meta["noise"] is None
+
+
+@pytest.mark.parametrize(
+    ("effect", "magnitude", "expected"),
+    [
+        (None, None, {}),
+        ("thruster_lift", 3.0e3, {"c_L": 3.0e3}),
+        ("azimuth_offset", -0.05, {"alpha_0": -0.05}),
+        ("current", 0.3, {"speed": 0.3}),
+    ],
+)
+def test_rvg_truth(effect: str | None, magnitude: float | None, expected: dict) -> None:
+    rec = _rvg(effect, magnitude=magnitude, duration=20.0, seed=9)
+    truth = rec.meta["truth"]
+    assert truth["model"] == "rvg3dof" and truth["base_model"] == "rvg3dof"
+    assert truth["effect"] == effect
+    assert truth["magnitude"] == magnitude
+    for key, value in expected.items():
+        assert truth["effect_params"][key] == pytest.approx(value)
+    if effect is None:
+        assert truth["effect_params"] == {}
+    # the parameters are plain JSON and rebuild the true ship
+    params = truth["params"]
+    assert isinstance(params["added_mass"], list) and len(params["added_mass"]) == 3
+    rebuilt = RVGParams(
+        **{k: tuple(v) if k in ("pod_x", "pod_y") else v for k, v in params.items()}
+    )
+    lift = magnitude if effect == "thruster_lift" else 0.0
+    assert rebuilt.pod_lift_coefficient == pytest.approx(lift)
+    np.testing.assert_array_equal(rebuilt.added_mass, RVGParams().added_mass)
+    assert truth["base_params"]["pod_lift_coefficient"] == 0.0
+    speed = magnitude if effect == "current" else 0.0
+    assert math.hypot(*truth["current"]) == pytest.approx(speed)
+    assert truth["fine_step"] <= 0.1
+
+
+@pytest.mark.parametrize("effect", [None, *_RVG_EFFECTS])
+def test_rvg_undeclared_and_reproducible(effect: str | None) -> None:
+    kwargs = {"maneuver": "random", "dt": 1.0, "duration": 300.0, "base_model": "rvg3dof"}
+    a = generate_record(effect, seed=7, **kwargs)
+    b = generate_record(effect, seed=7, **kwargs)
+    c = generate_record(effect, seed=8, **kwargs)
+    for name in ("time", "delta", "azimuth", "rpm", "psi", "r", "x", "y", "u", "v", "U"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert not np.array_equal(a.psi, c.psi)
+    assert not np.array_equal(a.azimuth, c.azimuth)
+    assert a.meta == b.meta
+    other = {k: v for k, v in a.meta.items() if k != "truth"}
+    clean = generate_record(None, seed=7, **kwargs)
+    assert other == {k: v for k, v in clean.meta.items() if k != "truth"}
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"effect": "wind", "base_model": "rvg3dof"}, r"'wind'.*'rvg3dof'.*thruster_lift"),
+        ({"effect": "rudder_lag", "base_model": "rvg3dof"}, r"'rudder_lag'.*'rvg3dof'.*current"),
+        ({"effect": "second_order", "base_model": "rvg3dof"}, r"'second_order'.*'rvg3dof'"),
+        ({"effect": "thruster_lift"}, r"'thruster_lift'.*'nomoto1'.*rudder_offset"),
+        ({"effect": "azimuth_offset", "base_model": "nomoto1"}, r"'azimuth_offset'.*'nomoto1'"),
+        ({"effect": "thruster_lift", "base_model": "rvg3dof", "magnitude": -1.0}, ">= 0"),
+        ({"effect": "azimuth_offset", "base_model": "rvg3dof", "magnitude": 2.0}, "alpha_0"),
+        ({"effect": "current", "base_model": "rvg3dof", "magnitude": -0.1}, ">= 0"),
+        ({"effect": "current", "base_model": "rvg3dof", "magnitude": math.nan}, "finite"),
+        ({"base_model": "rvg3dof", "magnitude": 1.0}, "effect"),
+        ({"base_model": "rvg3dof", "maneuver": "turning"}, "zigzag"),
+        ({"base_model": "rvg3dof", "duration": 1.0}, "duration"),
+    ],
+)
+def test_rvg_bad_input(kwargs: dict, match: str) -> None:
+    effect = kwargs.pop("effect", None)
+    with pytest.raises(ValueError, match=match):
+        generate_record(effect, **kwargs)

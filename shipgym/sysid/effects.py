@@ -72,18 +72,19 @@ The ground truth that :mod:`shipgym.sysid.generator` stores in ``meta["truth"]``
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
-from shipgym.models import Nomoto1Params, SteeringGear, make_model
+from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 from shipgym.sysid.fit import (
@@ -100,13 +101,15 @@ __all__ = [
     "CURRENT_T_MIN",
     "LAG_EQUIVALENT_T3",
     "MIN_RELATIVE_DROP",
+    "NOMOTO_CATALOGUE",
+    "RVG_CATALOGUE",
     "TIE_FRACTION",
     "IdentificationResult",
     "identify",
     "residual_diagnostics",
 ]
 
-CATALOGUE: tuple[str, ...] = (
+NOMOTO_CATALOGUE: tuple[str, ...] = (
     "rudder_offset",
     "yaw_nonlinearity",
     "rudder_lag",
@@ -114,7 +117,15 @@ CATALOGUE: tuple[str, ...] = (
     "current",
     "second_order",
 )
-"""Effects the loop can add (the names of :data:`shipgym.sysid.generator.EFFECTS`)."""
+"""Effects the loop can add to a Nomoto-family base."""
+
+RVG_CATALOGUE: tuple[str, ...] = ("thruster_lift", "azimuth_offset", "current")
+"""Effects the loop can add to the ``rvg3dof`` base (:mod:`shipgym.sysid.rvg_identify`)."""
+
+CATALOGUE: tuple[str, ...] = NOMOTO_CATALOGUE + tuple(
+    e for e in RVG_CATALOGUE if e not in NOMOTO_CATALOGUE
+)
+"""Every effect name (the names of :data:`shipgym.sysid.generator.EFFECTS`)."""
 
 BIC_MARGIN = 10.0
 """Required decrease of the held-out BIC ``J`` to accept an effect."""
@@ -140,7 +151,22 @@ _N_ADDED = {
 CURRENT_T_MIN = 5.0
 """Required ``|V| / stderr(V)`` of the drift velocity for ``current``."""
 
-_BASES = ("nomoto1",)
+BASES: tuple[str, ...] = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof")
+"""Base models of :func:`identify`."""
+
+_BASE_CONFIG = {
+    "nomoto1": {},
+    "nomoto2": {"second": True},
+    "norrbin": {"nonlinear": True},
+    "bech": {"second": True, "nonlinear": True},
+}
+_IN_BASE = {"second": "second_order", "nonlinear": "yaw_nonlinearity"}
+
+AUTO_WINDOW_DURATION = 1000.0
+"""Nomoto-family records longer than this [s] are scored in windows of :data:`AUTO_WINDOW_S`."""
+
+AUTO_WINDOW_S = 300.0
+"""Window [s] for long Nomoto-family records (``window_s="auto"``)."""
 _LAG_BOUNDS = (0.1, 40.0)
 _DELAY_BOUNDS = (0.0, 15.0)
 _LJUNG_BOX_LAGS = 20
@@ -229,6 +255,9 @@ def _lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = Non
 def _initial_rudder(fit: FitResult, t: np.ndarray, r: np.ndarray) -> float:
     """Rudder the ship feels at ``t[0]`` from the base fit: ``(T r'(0) + r(0)) / K - delta0``.
 
+    ``T`` is the first-order equivalent ``T1 + T2 - T3`` for second-order models; the
+    nonlinear terms are left out (an estimate of a filter's initial state).
+
     Used as the initial state of the ``rudder_lag`` filter (the recorded command and the actual
     rudder may differ at the start of a record); ``r(0)``, ``r'(0)`` from a quadratic
     Savitzky-Golay fit of the first 11 samples. Clipped to the gear's 35 deg.
@@ -237,7 +266,10 @@ def _initial_rudder(fit: FitResult, t: np.ndarray, r: np.ndarray) -> float:
     dt = float(np.median(np.diff(t)))
     r0 = float(savgol_filter(r[:w], w, 2)[0])
     rd0 = float(savgol_filter(r[:w], w, 2, deriv=1, delta=dt)[0])
-    K, T = fit.values["K"], fit.values["T"]
+    v = fit.values
+    K = v["K"]
+    # first-order equivalent time constant of a second-order model: T1 + T2 - T3
+    T = v["T"] if "T" in v else v["T1"] + v["T2"] - v["T3"]
     if K == 0:
         return 0.0
     lim = SteeringGear().max_angle
@@ -283,16 +315,39 @@ def _fit_config(
                 "reweight": reweight,
                 "max_nfev": None if reweight else 60,
             }
+            if cfg.nonlinear:
+                # start the nonlinear model from the linear fit with its terms off: the
+                # equation-error start of a polynomial yaw model is fragile on short segments
+                lin = fit_with_model(_Config(**{**cfg.__dict__, "nonlinear": False}), d_in, kw)
+                v = lin.values
+                if cfg.second:
+                    init: Any = BechParams(
+                        v["K"], v["T1"], v["T2"], v["T3"], 0.0, 1.0 / v["K"], 0.0, 0.0
+                    )
+                else:
+                    init = NorrbinParams(v["K"], v["T"], 0.0, 1.0, 0.0, 0.0)
+                if cfg.bias:  # rudder offset delta0 <-> n0 = -K delta0, b0 = n0 / K
+                    if cfg.second:
+                        init = replace(init, b0=-lin.delta0)
+                    else:
+                        init = replace(init, n0=-lin.delta0 * v["K"])
+                return fit_output_error(t, d_in, psi, r, cfg.model, bias=cfg.bias, init=init, **kw)
+            return fit_with_model(cfg, d_in, kw)
+
+    def fit_with_model(c: _Config, d_in: np.ndarray, kw: dict[str, Any]) -> FitResult:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", SysidWarning)
+            warnings.simplefilter("ignore", RuntimeWarning)
             try:
-                return fit_output_error(t, d_in, psi, r, cfg.model, bias=cfg.bias, **kw)
+                return fit_output_error(t, d_in, psi, r, c.model, bias=c.bias, **kw)
             except TypeError:
                 # the equation-error start of fit.py fails for nomoto2 with a bias
                 # (Nomoto2Params gets a delta0 keyword): start from the fit without bias
-                if not cfg.bias:
+                if not c.bias:
                     raise
-                start = fit_output_error(t, d_in, psi, r, cfg.model, bias=False, **kw)
+                start = fit_output_error(t, d_in, psi, r, c.model, bias=False, **kw)
                 return fit_output_error(
-                    t, d_in, psi, r, cfg.model, bias=True, init=start.params, **kw
+                    t, d_in, psi, r, c.model, bias=True, init=start.params, **kw
                 )
 
     def cost(f: FitResult) -> float:
@@ -375,6 +430,9 @@ def _score(
     sigma: tuple[float, float],
 ) -> dict[str, float]:
     sim = _predict(fitted, t, delta, psi, r, split, sigma)
+    if not np.all(np.isfinite(sim[:, [2, 4]])):  # the prediction diverged
+        inf = math.inf
+        return {"J": inf, "psi_rms_deg": inf, "r_rms_deg_s": inf, "k": float(fitted.n_params)}
     e_psi = _wrap(sim[:, 2] - psi[split:])
     e_r = sim[:, 4] - r[split:]
     n = e_psi.size
@@ -392,6 +450,118 @@ def _score(
 
 def _wrap(a: np.ndarray) -> np.ndarray:
     return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+# --------------------------------------------------------------------------------------------
+# reported errors: whole-record free run, or windows started from the measured state
+
+
+def _record_speed(rec: Record) -> np.ndarray | None:
+    if rec.U is not None:
+        return rec.U
+    if rec.u is not None:
+        return rec.u if rec.v is None else np.hypot(rec.u, rec.v)
+    return None
+
+
+def _window_starts(t: np.ndarray, window_s: float | None) -> np.ndarray:
+    """Start indices of consecutive windows of ``window_s`` seconds (one window if None).
+
+    A last window shorter than half ``window_s`` is merged into the one before.
+    """
+    if window_s is None:
+        return np.array([0])
+    edges = t[0] + window_s * np.arange(math.ceil((t[-1] - t[0]) / window_s))
+    starts = np.unique(np.searchsorted(t, edges - 1e-9 * window_s))
+    if starts.size > 1 and t[-1] - t[starts[-1]] < 0.5 * window_s:
+        starts = starts[:-1]
+    return starts
+
+
+def resolve_window(window_s: float | str | None, duration: float, base: str) -> float | None:
+    """The scoring window [s] for a record of ``duration`` seconds.
+
+    ``"auto"``: :data:`AUTO_WINDOW_S` for Nomoto-family records longer than
+    :data:`AUTO_WINDOW_DURATION`, none (whole-record free run) otherwise; for ``rvg3dof``
+    :data:`shipgym.sysid.rvg_identify.RVG_WINDOW_S`. A number must be positive.
+    """
+    if window_s == "auto":
+        if base == "rvg3dof":
+            from shipgym.sysid.rvg_identify import RVG_WINDOW_S
+
+            return RVG_WINDOW_S
+        return AUTO_WINDOW_S if duration > AUTO_WINDOW_DURATION else None
+    if window_s is None:
+        return None
+    if isinstance(window_s, bool) or not isinstance(window_s, int | float):
+        raise ValueError(f"window_s must be a number of seconds, 'auto' or None, got {window_s!r}")
+    if not (math.isfinite(window_s) and window_s > 0):
+        raise ValueError(f"window_s must be a positive number of seconds, got {window_s!r}")
+    return float(window_s)
+
+
+def _errors(
+    t: np.ndarray, rec: Record, sim: dict[str, np.ndarray], sl: slice = slice(None)
+) -> dict[str, float]:
+    """RMS errors of simulated channels against the record over the samples ``sl``."""
+    e_psi = _wrap(sim["psi"][sl] - rec.psi[sl])
+    out = {
+        "psi_rms_deg": math.degrees(float(np.sqrt(np.mean(e_psi**2)))),
+        "r_rms_deg_s": math.degrees(float(np.sqrt(np.mean((sim["r"][sl] - rec.r[sl]) ** 2)))),
+    }
+    if "x" in sim:
+        d2 = (sim["x"][sl] - rec.x[sl]) ** 2 + (sim["y"][sl] - rec.y[sl]) ** 2
+        out["xy_rms_m"] = float(np.sqrt(np.mean(d2)))
+    if "u" in sim and rec.u is not None:
+        out["u_rms_m_s"] = float(np.sqrt(np.mean((sim["u"][sl] - rec.u[sl]) ** 2)))
+    return out
+
+
+def _report(
+    fit: FitResult,
+    d_in: np.ndarray,
+    rec: Record,
+    starts: np.ndarray,
+    windowed: bool,
+    drift: tuple[float, float] = (0.0, 0.0),
+) -> dict[str, np.ndarray]:
+    """Simulated ``psi``, ``r`` (and ``x``, ``y``) of a Nomoto-family fit over the record.
+
+    Whole record (``windowed`` False): one free run from the fit's estimated initial state.
+    Windowed: each window starts from the measured ``psi``, ``r`` (``r'`` from a Savitzky-Golay
+    derivative for second-order models) and position. Positions use the recorded speed and, for
+    the ``current`` effect, the drift ``(V_n, V_e)``.
+    """
+    t = rec.time
+    speed = _record_speed(rec)
+    has_xy = rec.x is not None and rec.y is not None and speed is not None
+    nx = fit.x0.shape[0]
+    out = {k: np.empty(t.size) for k in ("psi", "r", "x", "y")}
+    rd = None
+    if windowed and nx == 7:
+        w = min(11, t.size // 2 * 2 - 1)
+        rd = savgol_filter(rec.r, w, 2, deriv=1, delta=float(np.median(np.diff(t))))
+    bounds = [*starts.tolist(), t.size]
+    for i0, i1 in itertools.pairwise(bounds):
+        x0 = fit.x0.copy()
+        if windowed:
+            x0[2], x0[4] = rec.psi[i0], rec.r[i0]
+            if rd is not None:
+                x0[6] = rd[i0]
+        if has_xy:
+            x0[0], x0[1] = rec.x[i0], rec.y[i0]
+        seg = slice(i0, i1)
+        U = speed[seg] if speed is not None else 1.0
+        if i1 - i0 < 2:  # a one-sample window: the measured state itself
+            sim = x0[None, :]
+        else:
+            sim = replay(fit.model_name, fit.params, t[seg], d_in[seg] + fit.delta0, x0, U)
+        out["psi"][seg], out["r"][seg] = sim[:, 2], sim[:, 4]
+        out["x"][seg] = sim[:, 0] + drift[0] * (t[seg] - t[i0])
+        out["y"][seg] = sim[:, 1] + drift[1] * (t[seg] - t[i0])
+    if not has_xy:
+        del out["x"], out["y"]
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -463,15 +633,9 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
             "xy_rms_m_after": rms[True],
         }
     )
-    # full-record drift fit (for the reported error and parameters)
+    # full-record drift fit (the reported parameters)
     Af = np.column_stack((np.ones_like(t), t - t[0]))
     full = [np.linalg.lstsq(Af, e, rcond=None)[0] for e in (ex, ey)]
-    out["xy_rms_full_before"] = math.sqrt(
-        float(np.mean((ex - ex[0]) ** 2 + (ey - ey[0]) ** 2)) / 2.0
-    )
-    out["xy_rms_full_after"] = math.sqrt(
-        float(np.mean((ex - Af @ full[0]) ** 2 + (ey - Af @ full[1]) ** 2)) / 2.0
-    )
     out["V_full"] = (float(full[0][1]), float(full[1][1]))
     return out
 
@@ -592,43 +756,78 @@ def residual_diagnostics(
 # the loop
 
 
+def _jsonable(obj: Any) -> Any:
+    """Plain-Python copy of nested dicts/lists of numbers (NaN and inf become None)."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, bool | np.bool_):
+        return bool(obj)
+    if isinstance(obj, int | np.integer):
+        return int(obj)
+    if isinstance(obj, float | np.floating):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
+
+
 @dataclass
 class IdentificationResult:
     """Outcome of :func:`identify`.
 
     Attributes
     ----------
-    base : FitResult
-        Output-error fit of the base model on the whole record.
-    final : FitResult
-        Output-error fit of the final model (with the accepted yaw effects) on the whole record.
+    model : str
+        The base model (``"nomoto1"`` ... ``"rvg3dof"``).
+    base, final : object
+        Whole-record fits of the base and final models (:class:`FitResult` for the Nomoto
+        family, :class:`shipgym.sysid.rvg_identify.RVGFit` for ``rvg3dof``).
     effects : list of dict
         Accepted effects in order: ``{"name", "parameters", "evidence"}``; ``evidence`` holds the
         held-out scores before/after, the BIC change and (``current``) the drift t statistic.
     diagnostics : dict
-        :func:`residual_diagnostics` of the base fit (whole record) under ``"base"`` and of the
-        final fit under ``"final"``.
+        Residual analysis of the base fit under ``"base"`` and of the final fit under
+        ``"final"`` (:func:`residual_diagnostics` for the Nomoto family).
     parameters_before, parameters_after : dict
         Estimated parameters of the base and final models (the effects' own parameters
-        ``T_d``, ``tau``, ``V_n``, ``V_e`` included).
+        ``T_d``, ``tau``, ``V_n``, ``V_e`` ... included).
     error_before, error_after : dict
-        Whole-record simulation error of the base and final models: ``psi_rms_deg``,
-        ``r_rms_deg_s`` and, with positions, ``xy_rms_m`` (dead reckoning residual per axis,
-        without / with the fitted drift).
+        Simulation error of the base and final models over the whole record: ``psi_rms_deg``,
+        ``r_rms_deg_s`` and, where the record has them, ``xy_rms_m`` (RMS distance between the
+        simulated and recorded positions) and ``u_rms_m_s`` (RVG only: a Nomoto model takes the
+        recorded speed as input). With ``window_s`` the record is cut into consecutive windows,
+        each simulated from the measured state; otherwise one free run from the estimated
+        initial state.
+    window_s : float or None
+        Scoring window [s] (None: whole-record free run).
+    heldout : dict
+        ``from_s`` (start of the held-out part, seconds from the record start), ``error_before``
+        and ``error_after``: the same errors over the held-out part for the models fitted on
+        the training part only.
+    traces : dict
+        ``time``, ``split`` (first held-out index), ``window_starts`` (indices) and, per channel
+        (``psi``, ``r``, and ``x``, ``y``, ``u`` where present), ``{"measured", "before",
+        "after"}`` arrays of the whole-record simulations behind ``error_before/after``.
     rounds : list of dict
         Every candidate's score per round (for inspection).
     runtime_s : float
         Wall time.
     """
 
-    base: FitResult
-    final: FitResult
+    model: str
+    base: Any
+    final: Any
     effects: list[dict[str, Any]]
     diagnostics: dict[str, Any]
     parameters_before: dict[str, float]
     parameters_after: dict[str, float]
     error_before: dict[str, float]
     error_after: dict[str, float]
+    window_s: float | None = None
+    heldout: dict[str, Any] = field(default_factory=dict)
+    traces: dict[str, Any] = field(default_factory=dict)
     rounds: list[dict[str, Any]] = field(default_factory=list)
     runtime_s: float = 0.0
 
@@ -637,6 +836,28 @@ class IdentificationResult:
         """Names of the accepted effects, in order."""
         return [e["name"] for e in self.effects]
 
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (the ``shipgym identify --json`` document).
+
+        Keys: ``model``, ``parameters_before``, ``error_before``, ``effects`` (``{name,
+        parameters, evidence}`` in order), ``parameters``, ``error_after``, ``window_s``,
+        ``heldout``, ``rounds``, ``runtime_s``. Non-finite numbers become ``null``.
+        """
+        return _jsonable(
+            {
+                "model": self.model,
+                "parameters_before": self.parameters_before,
+                "error_before": self.error_before,
+                "effects": self.effects,
+                "parameters": self.parameters_after,
+                "error_after": self.error_after,
+                "window_s": self.window_s,
+                "heldout": self.heldout,
+                "rounds": self.rounds,
+                "runtime_s": self.runtime_s,
+            }
+        )
+
 
 def identify(
     record: Record,
@@ -644,22 +865,29 @@ def identify(
     *,
     holdout: float = 0.3,
     max_effects: int = 3,
+    window_s: float | str | None = "auto",
     progress: Callable[[str], None] | None = None,
 ) -> IdentificationResult:
-    """Fit a base Nomoto model, then add catalogue effects while the held-out score improves.
+    """Fit a base model, then add catalogue effects while the held-out score improves.
 
     Parameters
     ----------
     record : Record
         A manoeuvre record (``time``, ``delta``, ``psi``, ``r``; ``x``, ``y`` and ``U`` or
-        ``u`` enable the ``current`` candidate).
-    base : {"nomoto1"}
-        Base model.
+        ``u`` enable the ``current`` candidate; ``rvg3dof`` needs ``rpm`` and positions and
+        speeds, as in the Gunnerus sea trials).
+    base : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof"}
+        Base model. A base that already has an effect's term (``nomoto2``: ``second_order``,
+        ``norrbin``: ``yaw_nonlinearity``, ``bech``: both) does not offer it as a candidate.
+        ``rvg3dof`` runs :func:`shipgym.sysid.rvg_identify.identify_rvg`.
     holdout : float
         Fraction of the record (its end) kept out of the fits and used for scoring, in
-        ``(0.1, 0.6)``.
+        ``[0.1, 0.6]``.
     max_effects : int
         Largest number of effects to add (>= 0).
+    window_s : float, "auto" or None
+        Report errors over consecutive windows of this many seconds, each simulated from the
+        measured state (:func:`resolve_window` for ``"auto"``); None: one free run.
     progress : callable, optional
         Called with a one-line message per candidate.
 
@@ -670,18 +898,30 @@ def identify(
     Raises
     ------
     ValueError
-        For a bad ``base``, ``holdout`` or ``max_effects``, or a record too short to split.
+        For a bad ``base``, ``holdout``, ``max_effects`` or ``window_s``, or a record too short
+        to split or lacking the channels the base needs.
     """
     t_start = time.perf_counter()
     if not isinstance(record, Record):
         raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(record).__name__}")
-    if base not in _BASES:
-        raise ValueError(f"unsupported base {base!r}; expected one of {_BASES}")
+    if base not in BASES:
+        raise ValueError(f"unsupported base {base!r}; expected one of {BASES}")
     if not (isinstance(holdout, int | float) and 0.1 <= float(holdout) <= 0.6):
         raise ValueError(f"holdout must be a fraction in [0.1, 0.6], got {holdout!r}")
     if not (isinstance(max_effects, int) and max_effects >= 0):
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
     t, delta, psi, r = record.time, record.delta, record.psi, record.r
+    window = resolve_window(window_s, float(t[-1] - t[0]), base)
+    if base == "rvg3dof":
+        from shipgym.sysid.rvg_identify import identify_rvg
+
+        return identify_rvg(
+            record,
+            holdout=float(holdout),
+            max_effects=max_effects,
+            window_s=window,
+            progress=progress,
+        )
     n = t.size
     split = round(n * (1.0 - float(holdout)))
     if split < 40 or n - split < 20:
@@ -697,20 +937,20 @@ def identify(
         base_full = fit_output_error(t, delta, psi, r, base)
     tr = slice(0, split)
     y0 = _initial_rudder(base_full, t, r)
-    cfg = _Config()
+    cfg = _Config(**_BASE_CONFIG[base])
     sigma = (max(base_full.rms_psi, 1e-6), max(base_full.rms_r, 1e-9))
     current_fit = _fit_config(cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None)
-    current_score = _score(current_fit, t, delta, psi, r, split, sigma)
+    current_score = base_score = _score(current_fit, t, delta, psi, r, split, sigma)
     say(f"base {base}: held-out psi {current_score['psi_rms_deg']:.3f} deg")
     cur_test = _current_test(record, split)
     effects: list[dict[str, Any]] = []
     rounds: list[dict[str, Any]] = []
     current_added = False
-    yaw_effects = [e for e in CATALOGUE if e != "current"]
+    yaw_effects = [e for e in NOMOTO_CATALOGUE if e != "current"]
     while len(effects) < max_effects:
         candidates: dict[str, dict[str, Any]] = {}
         for name in yaw_effects:
-            if name in [e["name"] for e in effects]:
+            if cfg.with_effect(name) == cfg:  # already in the model (base or accepted)
                 continue
             new_cfg = cfg.with_effect(name)
             try:
@@ -725,10 +965,11 @@ def identify(
                     "error": str(exc),
                 }
                 continue
-            dJ = sc["J"] - current_score["J"]
-            drop = 1.0 - sc["psi_rms_deg"] / current_score["psi_rms_deg"]
-            if not (math.isfinite(dJ) and math.isfinite(drop)):  # failed fit or simulation
+            if not math.isfinite(sc["J"]):  # failed fit or diverging prediction
                 dJ, drop = math.inf, -math.inf
+            else:  # (a diverging current model makes any finite candidate an improvement)
+                dJ = sc["J"] - current_score["J"]
+                drop = 1.0 - sc["psi_rms_deg"] / current_score["psi_rms_deg"]
             ok = dJ < -BIC_MARGIN and drop > MIN_RELATIVE_DROP
             candidates[name] = {
                 "fitted": fitted,
@@ -820,37 +1061,53 @@ def identify(
         k: float(v) for k, v in base_full.values.items() if k not in ("psi0", "r0", "r_dot0")
     }
     params_after = final.parameters()
-    err_before = {
-        "psi_rms_deg": math.degrees(base_full.rms_psi),
-        "r_rms_deg_s": math.degrees(base_full.rms_r),
-    }
-    err_after = {
-        "psi_rms_deg": math.degrees(final.fit.rms_psi),
-        "r_rms_deg_s": math.degrees(final.fit.rms_r),
-    }
-    if cur_test is not None:
-        err_before["xy_rms_m"] = cur_test["xy_rms_full_before"]
-        err_after["xy_rms_m"] = (
-            cur_test["xy_rms_full_after"] if current_added else cur_test["xy_rms_full_before"]
-        )
-        if current_added:
-            params_after["V_n"], params_after["V_e"] = cur_test["V_full"]
+    drift = (0.0, 0.0)
+    if current_added:
+        assert cur_test is not None
+        drift = cur_test["V_full"]
+        params_after["V_n"], params_after["V_e"] = drift
+    starts = _window_starts(t, window)
+    sim_before = _report(base_full, delta, record, starts, window is not None)
+    sim_after = _report(final.fit, d_final, record, starts, window is not None, drift)
     # update the accepted yaw effects' parameters to the whole-record fit
-    full_params = final.parameters()
     for e in effects:
         if e["name"] == "rudder_lag":
-            e["parameters"]["T_d"] = full_params["T_d"]
+            e["parameters"]["T_d"] = params_after["T_d"]
         elif e["name"] == "input_delay":
-            e["parameters"]["tau"] = full_params["tau"]
+            e["parameters"]["tau"] = params_after["tau"]
+    heldout = {
+        "from_s": float(t[split] - t[0]),
+        "error_before": {k: base_score[k] for k in ("psi_rms_deg", "r_rms_deg_s")},
+        "error_after": {k: current_score[k] for k in ("psi_rms_deg", "r_rms_deg_s")},
+    }
     return IdentificationResult(
+        model=base,
         base=base_full,
         final=final.fit,
         effects=effects,
         diagnostics=diagnostics,
         parameters_before=params_before,
         parameters_after=params_after,
-        error_before=err_before,
-        error_after=err_after,
+        error_before=_errors(t, record, sim_before),
+        error_after=_errors(t, record, sim_after),
+        window_s=window,
+        heldout=heldout,
+        traces=_traces(record, split, starts, sim_before, sim_after),
         rounds=rounds,
         runtime_s=time.perf_counter() - t_start,
     )
+
+
+def _traces(
+    rec: Record,
+    split: int,
+    starts: np.ndarray,
+    before: dict[str, np.ndarray],
+    after: dict[str, np.ndarray],
+) -> dict[str, Any]:
+    """The ``traces`` of :class:`IdentificationResult` (measured vs before vs after)."""
+    out: dict[str, Any] = {"time": rec.time, "split": split, "window_starts": starts}
+    for ch in ("psi", "r", "x", "y", "u"):
+        if ch in before and ch in after and getattr(rec, ch) is not None:
+            out[ch] = {"measured": getattr(rec, ch), "before": before[ch], "after": after[ch]}
+    return out

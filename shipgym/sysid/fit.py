@@ -771,6 +771,33 @@ def _start_values(
             )
             _evaluate(cand, t, delta, psi, r, np.ones_like(t))
             candidates.append(cand)
+    if model in ("norrbin", "bech"):
+        # the linear model with the nonlinear terms off: a stable start, where the direct
+        # regression may land on the wrong sign of n1 (an unstable-ship branch)
+        lin_fit = attempt("nomoto1" if model == "norrbin" else "nomoto2")
+        if lin_fit is not None:
+            v = lin_fit.values
+            if model == "norrbin":
+                params = NorrbinParams(v["K"], v["T"], 0.0, 1.0, 0.0, 0.0)
+            else:
+                params = BechParams(v["K"], v["T1"], v["T2"], v["T3"], 0.0, 1.0 / v["K"], 0.0, 0.0)
+            cand = FitResult(
+                model,
+                params,
+                {},
+                {},
+                np.zeros((0, 0)),
+                (),
+                _initial_state(model, t, r, psi, window, 3),
+                math.nan,
+                math.nan,
+                math.nan,
+                "equation_error",
+                t.shape[0],
+                lin_fit.delta0,
+            )
+            _evaluate(cand, t, delta, psi, r, np.ones_like(t))
+            candidates.append(cand)
     if not candidates:
         return _PARAM_CLASS[model](), 0.0
     best = min(candidates, key=lambda c: c.rms_r if math.isfinite(c.rms_r) else math.inf)

@@ -2,14 +2,22 @@
 
 Issue 4 section 5 asks for "the project's own generator of records with one undeclared effect":
 a record that looks like a measured one (:class:`shipgym.sysid.data.Record`, canonical units and
-sign convention) but whose ship deviates from the base model, the first-order Nomoto ship
-``T r' + r = K delta`` (seed 000, seed 004 eq. 2) with the Mariner defaults of
-:mod:`shipgym.models` (``K = 0.185 1/s``, ``T = 107.3 s``, service speed 7.7 m/s, steering gear
-``T_delta = 2 s``, 35 deg, 2.32 deg/s), in exactly one documented way. Every record is simulated
-through :mod:`shipgym.models` (:meth:`ShipModel.simulate` with the manoeuvre as a controller
-callback ``(t, x) -> [delta_c, n]``); no model equation is written here.
+sign convention) but whose ship deviates from a base model (:data:`BASE_MODELS`) in exactly one
+documented way. Every record is simulated through :mod:`shipgym.models`
+(:meth:`ShipModel.simulate` with the manoeuvre as a controller callback); no model equation is
+written here. Two base models:
 
-Effects (:data:`EFFECTS`; ``magnitude`` is in the unit given, the default in brackets):
+* ``"nomoto1"``: the first-order Nomoto ship ``T r' + r = K delta`` (seed 000, seed 004 eq. 2)
+  with the Mariner defaults of :mod:`shipgym.models` (``K = 0.185 1/s``, ``T = 107.3 s``, service
+  speed 7.7 m/s, steering gear ``T_delta = 2 s``, 35 deg, 2.32 deg/s); controller
+  ``(t, x) -> [delta_c, n]``.
+* ``"rvg3dof"``: the R/V Gunnerus 3-DOF model (seed 001 eq. 5-20, :mod:`shipgym.models.rvg`)
+  with the :class:`~shipgym.models.RVGParams` defaults (pods: first-order thrust and azimuth,
+  eq. 18; pod loads, eq. 19-20), producing Gunnerus-like records (section 6 of
+  ``data/measured/SOURCES.md``); controller ``(t, x) -> [T_c, T_c, alpha_c, alpha_c]``.
+
+Effects of the ``"nomoto1"`` base (:data:`EFFECTS_BY_BASE`; ``magnitude`` is in the unit given,
+the default in brackets):
 
 =================== ===========================================================================
 effect              definition
@@ -42,29 +50,78 @@ effect              definition
                     ``T1 + T2 - T3`` equals the base ``T``.
 =================== ===========================================================================
 
-Manoeuvres:
+Effects of the ``"rvg3dof"`` base (the clean ship, ``effect=None``, is seed 001's model: no pod
+lift, no offset, no current):
+
+=================== ===========================================================================
+effect              definition
+=================== ===========================================================================
+``thruster_lift``   The pods are foils: the true ship has ``RVGParams(pod_lift_coefficient=
+                    c_L)`` with ``c_L`` [N s^2/m^2] (``POD_LIFT_COEFFICIENT_THRUSTER_DATA``,
+                    about 6.48e3, the value implied by the Kongsberg pod data), i.e. each pod
+                    adds the side force ``L = c_L u_r |u_r| sin(alpha)`` that seed 001 eq.
+                    (19) leaves out. It grows with the square of the speed, unlike the thrust
+                    side force ``T sin(alpha)``.
+``azimuth_offset``  The pods' actual azimuth command is the recorded command plus ``alpha_0``
+                    [rad] (2 deg) on both pods (an encoder or calibration bias; ``|alpha_0|``
+                    below 90 deg). The recorded azimuth does NOT contain the offset; a
+                    positive ``alpha_0`` turns the ship to port on a zero command.
+``current``         A constant irrotational current of speed ``V_c`` [m/s] (0.5 m/s) toward a
+                    direction drawn from the seed as for ``nomoto1``, passed to the model
+                    (seed 001 eq. 7-12: it enters the kinetics through the relative velocity
+                    ``nu_r = nu - nu_c`` and the propeller law through ``u_r``). The recorded
+                    ``u``, ``v`` are ground velocities, as in the sea trial.
+=================== ===========================================================================
+
+Manoeuvres (``maneuver``):
 
 * ``"zigzag"``: a 20/20 zigzag (IMO style, ``ZIGZAG_ANGLE``): the command starts at +20 deg
   (starboard) and switches sign each time the heading passes +-20 deg from the initial heading
-  (simple switching rule on the true heading).
-* ``"random"``: a piecewise-constant random rudder command, amplitudes uniform in
-  ``[-RANDOM_MAX_RUDDER, RANDOM_MAX_RUDDER]`` (25 deg), hold times uniform in
-  ``RANDOM_HOLD`` (15 to 60 s), drawn from the seed.
+  (simple switching rule on the true heading). For ``rvg3dof`` the command is the pods' azimuth
+  with their own sign, ``azimuth = -delta`` (it starts at -20 deg, a starboard turn), at a
+  constant ``RVG_ZIGZAG_RPM`` (170 rpm). Seed 001's ship steers weakly: the clean 20/20 zigzag
+  overshoots by about 37 deg (97 deg the first time) at about 3.6 m/s; with the default foil
+  lift by about 18 deg.
+* ``"random"``: a piecewise-constant random rudder (``nomoto1``) or azimuth (``rvg3dof``)
+  command, levels uniform in ``[-RANDOM_MAX_RUDDER, RANDOM_MAX_RUDDER]`` (25 deg), hold times
+  uniform in ``RANDOM_HOLD`` (15 to 60 s), drawn from the seed. For ``rvg3dof`` the rpm command
+  is piecewise constant too, on the levels ``RVG_RPM_LEVELS`` (110, 140, 170, 195 rpm: the
+  first drawn uniformly, each later one uniformly among the other three), each held a time
+  uniform in ``RVG_RPM_HOLD`` (60 to 180 s), from its own random stream: the speed variation is
+  what separates the foil lift (``~ u_r^2``) from the thrust side force.
 
-The shaft speed is the service shaft speed throughout (``U`` stays at 7.7 m/s: the Nomoto models
-have no speed loss in turns). The simulation runs with a fine step ``h = dt / ceil(dt / 0.1)``
-(at most 0.1 s) and is sampled every ``dt``.
+``nomoto1``: the shaft speed is the service shaft speed throughout (``U`` stays at 7.7 m/s: the
+Nomoto models have no speed loss in turns). ``rvg3dof``: the record carries the COMMANDS, like
+the Gunnerus sea trial: ``azimuth`` [rad, positive turns to port], ``delta = -azimuth`` and
+``rpm`` [rev/min]; at every fine step the rpm command is turned into the per-pod thrust command
+``T_c = pod_thrust(rpm, u_r)`` (the project's propeller law, :func:`shipgym.models.rvg.pod_thrust`,
+with ``u_r`` the body surge minus the body-frame current component, seed 001 eq. 8), and the pods
+follow ``[T_c, T_c, alpha_c, alpha_c]`` through their first-order dynamics (eq. 18). The ship
+starts in steady straight running at the initial rpm command with heading 0 and the pods at zero
+azimuth: the steady relative surge speed ``u_0`` is the root of the model's surge acceleration
+(:meth:`ShipModel.deriv`, ``brentq``) with the thrust states at ``pod_thrust(rpm, u_0)``; with a
+current, the ground velocity is ``[u_0, 0]`` plus the body-frame current, so the ship starts
+steady in the water. Default durations: :data:`DEFAULT_DURATIONS` (600 s for ``nomoto1``, 1200 s
+for ``rvg3dof``). The simulation runs with a fine step ``h = dt / ceil(dt / 0.1)`` (at most
+0.1 s) and is sampled every ``dt``.
 
 Sensor noise (``noise=True``; :data:`NOISE`, white Gaussian, independent per sample and channel):
-heading 0.1 deg, yaw rate 0.02 deg/s, rudder 0.1 deg, positions 1 m, speed 0.02 m/s. The noise
-draws come from their own random stream, so ``noise=False`` gives the same trajectory. The
-rudder noise is an errors-in-variables disturbance for a fit that replays the recorded rudder:
-through ``K / (s (1 + T s))`` it makes the replayed heading wander slowly, so the psi residual of
-a correct output-error fit of a clean 600 s record is 1.0 to 1.1 times the heading noise at
-``dt = 0.1 s`` and up to about 2 times at ``dt = 1 s`` (the r residual stays at its noise level).
+heading 0.1 deg, yaw rate 0.02 deg/s, positions 1 m; ``nomoto1``: rudder 0.1 deg, speed
+0.02 m/s; ``rvg3dof``: body velocities ``u``, ``v`` 0.02 m/s each (``U = hypot(u, v)`` is
+computed from the noisy ``u``, ``v``, as the sea-trial loader does) and NO noise on the commands
+``azimuth``, ``delta``, ``rpm``. The noise draws come from their own random stream, so
+``noise=False`` gives the same trajectory. The ``nomoto1`` rudder noise is an
+errors-in-variables disturbance for a fit that replays the recorded rudder: through
+``K / (s (1 + T s))`` it makes the replayed heading wander slowly, so the psi residual of a
+correct output-error fit of a clean 600 s record is 1.0 to 1.1 times the heading noise at
+``dt = 0.1 s`` and up to about 2 times at ``dt = 1 s`` (the r residual stays at its noise
+level).
 
-The ground truth (true model name and parameters, gear, surge, current, base model, the effect
-and its parameters, the realised delay...) is stored in ``record.meta["truth"]``. It is there
+The ground truth (true model name and parameters, gear, surge, current, initial state, base
+model, the effect and its parameters, the realised delay...) is stored in
+``record.meta["truth"]`` (for ``rvg3dof`` the :class:`~shipgym.models.RVGParams` as a plain dict
+with lists for the matrices, ``gear = surge = None``, and the steady relative surge speed
+``u_0``). It is there
 for tests and benchmarks only: **an identifier or diagnostic must not read it**; nothing else in
 the record (channels or the other meta keys) depends on which effect was applied, apart from the
 effect's influence on the signals.
@@ -73,40 +130,63 @@ effect's influence on the signals.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict
 from typing import Any, Literal
 
 import numpy as np
+from scipy.optimize import brentq
 
 from shipgym.models import (
     Nomoto1Params,
     Nomoto2Params,
     NorrbinParams,
+    RVGParams,
+    ShipModel,
     SteeringGear,
     SurgeModel,
     make_model,
 )
+from shipgym.models import rvg as _rvg
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IU, IX, IY
 from shipgym.sysid.data import Record
 
 __all__ = [
     "BASE_MODELS",
+    "DEFAULT_DURATIONS",
     "EFFECTS",
+    "EFFECTS_BY_BASE",
     "EFFECT_DEFAULTS",
     "MANEUVERS",
     "NOISE",
+    "RVG_RPM_HOLD",
+    "RVG_RPM_LEVELS",
+    "RVG_ZIGZAG_RPM",
     "generate_record",
 ]
 
-EFFECTS: tuple[str, ...] = (
-    "rudder_offset",
-    "yaw_nonlinearity",
-    "rudder_lag",
-    "input_delay",
-    "current",
-    "second_order",
+BASE_MODELS: tuple[str, ...] = ("nomoto1", "rvg3dof")
+"""Base models the effects are defined against: the first-order Nomoto ship and the R/V
+Gunnerus 3-DOF model."""
+
+EFFECTS_BY_BASE: dict[str, tuple[str, ...]] = {
+    "nomoto1": (
+        "rudder_offset",
+        "yaw_nonlinearity",
+        "rudder_lag",
+        "input_delay",
+        "current",
+        "second_order",
+    ),
+    "rvg3dof": ("thruster_lift", "azimuth_offset", "current"),
+}
+"""The undeclared effects defined for each base model (see the module docstring)."""
+
+EFFECTS: tuple[str, ...] = tuple(
+    dict.fromkeys(e for base in BASE_MODELS for e in EFFECTS_BY_BASE[base])
 )
-"""Catalogue of the undeclared effects (see the module docstring)."""
+"""Catalogue of all undeclared effects (the union over :data:`EFFECTS_BY_BASE`, ``nomoto1``'s
+first)."""
 
 EFFECT_DEFAULTS: dict[str, float] = {
     "rudder_offset": math.radians(2.0),  # delta_0 [rad]
@@ -115,35 +195,49 @@ EFFECT_DEFAULTS: dict[str, float] = {
     "input_delay": 3.0,  # tau [s]
     "current": 0.5,  # current speed [m/s]
     "second_order": 7.8,  # T2 [s]
+    "thruster_lift": _rvg.POD_LIFT_COEFFICIENT_THRUSTER_DATA,  # c_L [N s^2/m^2]
+    "azimuth_offset": math.radians(2.0),  # alpha_0 [rad]
 }
-"""Default ``magnitude`` of each effect, in the unit of the module docstring's table."""
+"""Default ``magnitude`` of each effect, in the unit of the module docstring's tables."""
 
 MANEUVERS: tuple[str, ...] = ("zigzag", "random")
 """Accepted values of ``maneuver``."""
 
-BASE_MODELS: tuple[str, ...] = ("nomoto1",)
-"""Base models the effects are defined against (only the first-order Nomoto ship)."""
-
 NOISE: dict[str, float] = {
     "psi": math.radians(0.1),  # rad
     "r": math.radians(0.02),  # rad/s
-    "delta": math.radians(0.1),  # rad
+    "delta": math.radians(0.1),  # rad (nomoto1 only: the RVG commands carry no noise)
     "xy": 1.0,  # m
-    "U": 0.02,  # m/s
+    "U": 0.02,  # m/s (nomoto1)
+    "uv": 0.02,  # m/s, each of the body velocities u, v (rvg3dof)
 }
 """Standard deviations of the Gaussian sensor noise (``noise=True``)."""
 
+_NOISE_KEYS = {"nomoto1": ("psi", "r", "delta", "xy", "U"), "rvg3dof": ("psi", "r", "xy", "uv")}
+
 ZIGZAG_ANGLE = math.radians(20.0)
-"""Rudder and heading-switch angle [rad] of the zigzag (20/20)."""
+"""Rudder (or azimuth) and heading-switch angle [rad] of the zigzag (20/20)."""
 
 RANDOM_MAX_RUDDER = math.radians(25.0)
-"""Largest random rudder command [rad]."""
+"""Largest random rudder (or azimuth) command [rad]."""
 
 RANDOM_HOLD = (15.0, 60.0)
 """Range [s] of the random hold times."""
 
 DEFAULT_DURATION = 600.0
-"""Default record length [s]."""
+"""Default record length [s] of the ``nomoto1`` base."""
+
+DEFAULT_DURATIONS: dict[str, float] = {"nomoto1": DEFAULT_DURATION, "rvg3dof": 1200.0}
+"""Default record length [s] per base model."""
+
+RVG_ZIGZAG_RPM = 170.0
+"""Constant rpm command [rev/min] of the RVG zigzag (the sea trial's turning rpm)."""
+
+RVG_RPM_LEVELS: tuple[float, ...] = (110.0, 140.0, 170.0, 195.0)
+"""rpm command levels [rev/min] of the RVG random manoeuvre (195 is the sea trial's cap)."""
+
+RVG_RPM_HOLD = (60.0, 180.0)
+"""Range [s] of the hold times of the RVG random rpm command."""
 
 _MAX_FINE_STEP = 0.1
 
@@ -156,19 +250,24 @@ def _check_inputs(
     base_model: str,
     magnitude: float | None,
 ) -> tuple[float, float, float | None]:
-    if effect is not None and effect not in EFFECTS:
-        raise ValueError(f"unknown effect {effect!r}; expected None or one of {EFFECTS}")
-    if maneuver not in MANEUVERS:
-        raise ValueError(f"unknown maneuver {maneuver!r}; expected one of {MANEUVERS}")
     if base_model not in BASE_MODELS:
         raise ValueError(f"unsupported base_model {base_model!r}; expected one of {BASE_MODELS}")
+    valid = EFFECTS_BY_BASE[base_model]
+    if effect is not None and effect not in valid:
+        kind = "is not defined" if effect in EFFECTS else "is unknown"
+        raise ValueError(
+            f"effect {effect!r} {kind} for base_model {base_model!r}; expected None or one of "
+            f"{valid}"
+        )
+    if maneuver not in MANEUVERS:
+        raise ValueError(f"unknown maneuver {maneuver!r}; expected one of {MANEUVERS}")
     try:
         dt = float(dt)
     except (TypeError, ValueError):
         raise ValueError(f"dt must be a number of seconds, got {dt!r}") from None
     if not (math.isfinite(dt) and 0.0 < dt <= 10.0):
         raise ValueError(f"dt must be a sampling interval in (0, 10] s, got {dt!r}")
-    dur = DEFAULT_DURATION if duration is None else duration
+    dur = DEFAULT_DURATIONS[base_model] if duration is None else duration
     try:
         dur = float(dur)
     except (TypeError, ValueError):
@@ -186,12 +285,20 @@ def _check_inputs(
             raise ValueError(f"magnitude must be finite, got {magnitude!r}")
         if effect in ("rudder_lag", "second_order") and magnitude <= 0.0:
             raise ValueError(f"magnitude of {effect!r} is a time constant and must be > 0 s")
-        if effect in ("input_delay", "current", "yaw_nonlinearity") and magnitude < 0.0:
+        if (
+            effect in ("input_delay", "current", "yaw_nonlinearity", "thruster_lift")
+            and magnitude < 0.0
+        ):
             raise ValueError(f"magnitude of {effect!r} must be >= 0, got {magnitude!r}")
         if effect == "second_order" and magnitude >= Nomoto1Params().T + Nomoto2Params().T3:
             raise ValueError(
                 f"magnitude (T2) of 'second_order' must be < T + T3 = "
                 f"{Nomoto1Params().T + Nomoto2Params().T3:g} s so that T1 > 0"
+            )
+        if effect == "azimuth_offset" and not abs(magnitude) < 0.5 * math.pi:
+            raise ValueError(
+                f"magnitude (alpha_0) of 'azimuth_offset' must be an angle in (-pi/2, pi/2) rad "
+                f"so that the pods still push ahead, got {magnitude!r}"
             )
     return dt, dur, magnitude
 
@@ -206,6 +313,32 @@ def _random_command(rng: np.random.Generator, t_end: float) -> tuple[np.ndarray,
     return np.array(times), np.array(levels)
 
 
+def _random_rpm(rng: np.random.Generator, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+    """Switch times and levels of the piecewise-constant random rpm command of the RVG.
+
+    Each switch moves to one of the other levels (uniformly), so every hold is a real change.
+    """
+    times = [0.0]
+    levels = [float(rng.choice(RVG_RPM_LEVELS))]
+    while times[-1] <= t_end:
+        times.append(times[-1] + float(rng.uniform(*RVG_RPM_HOLD)))
+        others = [level for level in RVG_RPM_LEVELS if level != levels[-1]]
+        levels.append(float(rng.choice(others)))
+    return np.array(times), np.array(levels)
+
+
+def _draw_current(rng: np.random.Generator, speed: float) -> tuple[np.ndarray, dict[str, Any]]:
+    """Current of ``speed`` [m/s] toward a direction uniform on [0, 2 pi), and its description."""
+    direction = float(rng.uniform(0.0, 2.0 * math.pi))
+    current = speed * np.array([math.cos(direction), math.sin(direction)])
+    return current, {
+        "speed": speed,
+        "direction": direction,
+        "V_n": float(current[0]),
+        "V_e": float(current[1]),
+    }
+
+
 def generate_record(
     effect: str | None = None,
     *,
@@ -217,44 +350,66 @@ def generate_record(
     base_model: str = "nomoto1",
     magnitude: float | None = None,
 ) -> Record:
-    """Simulate a manoeuvre of the Mariner Nomoto ship with at most one undeclared effect.
+    """Simulate a manoeuvre of a base ship (Mariner Nomoto or R/V Gunnerus) with at most one
+    undeclared effect.
 
     Parameters
     ----------
     effect : str or None
-        One of :data:`EFFECTS` (see the module docstring), or None for a clean first-order
-        Nomoto ship.
+        One of ``EFFECTS_BY_BASE[base_model]`` (see the module docstring), or None for the clean
+        base ship.
     maneuver : {"zigzag", "random"}
-        20/20 zigzag on the heading, or a random piecewise-constant rudder command.
+        20/20 zigzag on the heading, or a random piecewise-constant rudder (azimuth and rpm for
+        ``rvg3dof``) command.
     dt : float
         Sampling interval [s] of the record, in (0, 10].
     duration : float, optional
-        Record length [s] (default 600 s); at least ``10 dt``.
+        Record length [s] (default :data:`DEFAULT_DURATIONS`: 600 s for ``nomoto1``, 1200 s for
+        ``rvg3dof``); at least ``10 dt``.
     noise : bool
-        Add Gaussian sensor noise (:data:`NOISE`) to every recorded channel.
+        Add Gaussian sensor noise (:data:`NOISE`) to every recorded measurement channel (not to
+        the RVG commands ``azimuth``, ``delta``, ``rpm``).
     seed : int
         Seed of the random manoeuvre, the current direction and the noise (reproducible).
-    base_model : str
-        The model the effect deviates from; only ``"nomoto1"`` (:data:`BASE_MODELS`).
+    base_model : {"nomoto1", "rvg3dof"}
+        The model the effect deviates from (:data:`BASE_MODELS`).
     magnitude : float, optional
         Size of the effect in its unit (:data:`EFFECT_DEFAULTS` by default).
 
     Returns
     -------
     Record
-        ``time`` (``k dt``), ``delta`` (measured rudder: the gear state, or the command for
-        ``rudder_lag``), ``psi``, ``r``, ``x``, ``y`` (north/east from the start), ``U``.
-        ``meta["truth"]`` holds the ground truth, for tests only: identifiers must not read it.
+        ``nomoto1``: ``time`` (``k dt``), ``delta`` (measured rudder: the gear state, or the
+        command for ``rudder_lag``), ``psi``, ``r``, ``x``, ``y`` (north/east from the start),
+        ``U``. ``rvg3dof``: ``time``, ``azimuth`` (command [rad], positive turns to port),
+        ``delta = -azimuth``, ``rpm`` (command [rev/min]), ``psi``, ``r``, ``x``, ``y``, ``u``,
+        ``v`` (body velocities over ground), ``U = hypot(u, v)``. ``meta["truth"]`` holds the
+        ground truth, for tests only: identifiers must not read it.
 
     Raises
     ------
     ValueError
-        For an unknown effect, manoeuvre or base model, or a bad ``dt``, ``duration`` or
-        ``magnitude``.
+        For an unknown base model or manoeuvre, an effect not defined for the base model, or a
+        bad ``dt``, ``duration`` or ``magnitude``.
     """
     dt, dur, magnitude = _check_inputs(effect, maneuver, dt, duration, base_model, magnitude)
     if effect is not None and magnitude is None:
         magnitude = EFFECT_DEFAULTS[effect]
+    if base_model == "rvg3dof":
+        return _rvg_record(effect, maneuver, dt, dur, noise, seed, magnitude)
+    return _nomoto_record(effect, maneuver, dt, dur, noise, seed, magnitude)
+
+
+def _nomoto_record(
+    effect: str | None,
+    maneuver: str,
+    dt: float,
+    dur: float,
+    noise: bool,
+    seed: int,
+    magnitude: float | None,
+) -> Record:
+    """The ``nomoto1`` branch of :func:`generate_record` (inputs already checked)."""
     seq = np.random.SeedSequence(int(seed))
     rng_man, rng_cur, rng_noise = (np.random.default_rng(s) for s in seq.spawn(3))
 
@@ -290,14 +445,7 @@ def generate_record(
         effect_params = {"tau": delay_steps * h, "tau_requested": magnitude}
     elif effect == "current":
         assert magnitude is not None
-        direction = float(rng_cur.uniform(0.0, 2.0 * math.pi))
-        current = magnitude * np.array([math.cos(direction), math.sin(direction)])
-        effect_params = {
-            "speed": magnitude,
-            "direction": direction,
-            "V_n": float(current[0]),
-            "V_e": float(current[1]),
-        }
+        current, effect_params = _draw_current(rng_cur, magnitude)
     elif effect == "second_order":
         assert magnitude is not None
         d2 = Nomoto2Params()
@@ -362,7 +510,7 @@ def generate_record(
         "surge": asdict(surge),
         "current": current.tolist(),
         "x0": x0.tolist(),
-        "base_model": base_model,
+        "base_model": "nomoto1",
         "base_params": asdict(base),
         "effect": effect,
         "effect_params": effect_params,
@@ -379,7 +527,7 @@ def generate_record(
         "maneuver": maneuver,
         "dt": dt,
         "seed": int(seed),
-        "noise": dict(NOISE) if noise else None,
+        "noise": {k: NOISE[k] for k in _NOISE_KEYS["nomoto1"]} if noise else None,
         "conversions": [],
         "repairs": [],
         "notes": [
@@ -389,3 +537,193 @@ def generate_record(
         "truth": truth,
     }
     return Record(time=time, delta=delta, psi=psi, r=r, x=x, y=y, U=U, meta=meta)
+
+
+def _rvg_params_dict(params: RVGParams) -> dict[str, Any]:
+    """``RVGParams`` as a plain JSON-able dict (matrices as nested lists)."""
+    return {
+        k: (v.tolist() if isinstance(v, np.ndarray) else list(v) if isinstance(v, tuple) else v)
+        for k, v in asdict(params).items()
+    }
+
+
+def _rvg_steady_surge(model: ShipModel, rpm: float) -> float:
+    """Relative surge speed [m/s] of steady straight running at ``rpm`` in calm water.
+
+    The root of the model's surge acceleration with zero azimuth, ``v = r = 0`` and both thrust
+    states (and commands) at ``pod_thrust(rpm, u)`` (module docstring).
+    """
+    p = model.p
+    x = np.zeros(model.nx)
+
+    def surge_acceleration(u: float) -> float:
+        thrust = _rvg.pod_thrust(rpm, u, p)
+        x[_rvg.IU] = u
+        x[_rvg.IT1] = x[_rvg.IT2] = thrust
+        return float(model.deriv(x, [thrust, thrust, 0.0, 0.0])[0, _rvg.IU])
+
+    # the thrust, hence the acceleration, is > 0 at rest and 0 at the thrust-limit speed
+    return float(brentq(surge_acceleration, 0.0, model.params.thrust_zero_speed, xtol=1e-13))
+
+
+def _rvg_record(
+    effect: str | None,
+    maneuver: str,
+    dt: float,
+    dur: float,
+    noise: bool,
+    seed: int,
+    magnitude: float | None,
+) -> Record:
+    """The ``rvg3dof`` branch of :func:`generate_record` (inputs already checked)."""
+    seq = np.random.SeedSequence(int(seed))
+    # the first three streams as for nomoto1 (azimuth as the rudder, current, noise), then rpm
+    rng_man, rng_cur, rng_noise, rng_rpm = (np.random.default_rng(s) for s in seq.spawn(4))
+
+    m = max(1, math.ceil(dt / _MAX_FINE_STEP - 1e-9))
+    h = dt / m
+    n_samples = math.floor(dur / dt + 1e-9) + 1
+    n_fine = (n_samples - 1) * m
+
+    base = RVGParams()
+    params = base
+    current = np.zeros(2)
+    alpha_0 = 0.0
+    effect_params: dict[str, Any] = {}
+    if effect == "thruster_lift":
+        assert magnitude is not None
+        params = RVGParams(pod_lift_coefficient=magnitude)
+        effect_params = {"c_L": magnitude}
+    elif effect == "azimuth_offset":
+        assert magnitude is not None
+        alpha_0 = magnitude
+        effect_params = {"alpha_0": magnitude}
+    elif effect == "current":
+        assert magnitude is not None
+        current, effect_params = _draw_current(rng_cur, magnitude)
+    model = make_model("rvg3dof", params)
+    p = model.p
+    t_end = (n_fine + 1) * h
+
+    # The manoeuvre decides the azimuth and rpm COMMANDS (the recorded channels) from the state.
+    azimuth_cmd: Callable[[float, np.ndarray], float]
+    rpm_cmd: Callable[[float], float]
+    if maneuver == "zigzag":
+        sign = [1.0]  # sign of delta = -azimuth: starts with a starboard turn
+
+        def azimuth_cmd(t: float, x: np.ndarray) -> float:
+            dpsi = x[_rvg.IPSI]  # the initial heading is 0
+            if sign[0] > 0 and dpsi >= ZIGZAG_ANGLE:
+                sign[0] = -1.0
+            elif sign[0] < 0 and dpsi <= -ZIGZAG_ANGLE:
+                sign[0] = 1.0
+            return -sign[0] * ZIGZAG_ANGLE
+
+        def rpm_cmd(t: float) -> float:
+            return RVG_ZIGZAG_RPM
+
+    else:
+        az_t, az_levels = _random_command(rng_man, t_end)
+        rpm_t, rpm_levels = _random_rpm(rng_rpm, t_end)
+
+        def azimuth_cmd(t: float, x: np.ndarray) -> float:
+            return float(az_levels[np.searchsorted(az_t, t + 1e-9 * h, side="right") - 1])
+
+        def rpm_cmd(t: float) -> float:
+            return float(rpm_levels[np.searchsorted(rpm_t, t + 1e-9 * h, side="right") - 1])
+
+    # steady straight running at the initial rpm, steady in the water (see module docstring)
+    rpm0 = rpm_cmd(0.0)
+    u_r0 = _rvg_steady_surge(model, rpm0)
+    thrust0 = _rvg.pod_thrust(rpm0, u_r0, p)
+    x0 = np.zeros(model.nx)
+    x0[_rvg.IU] = u_r0 + current[0]  # body-frame current at psi = 0 is (V_n, V_e)
+    x0[_rvg.IV] = current[1]
+    x0[_rvg.IT1] = x0[_rvg.IT2] = thrust0
+
+    v_n, v_e = float(current[0]), float(current[1])
+    azimuths: list[float] = []
+    rpms: list[float] = []
+
+    def controller(t: float, x: np.ndarray) -> list[float]:
+        azimuth = azimuth_cmd(t, x)
+        rpm = rpm_cmd(t)
+        azimuths.append(azimuth)
+        rpms.append(rpm)
+        psi = x[_rvg.IPSI]
+        u_r = x[_rvg.IU] - (v_n * math.cos(psi) + v_e * math.sin(psi))  # seed 001 eq. 8, 10
+        thrust = _rvg.pod_thrust(rpm, u_r, p)
+        alpha = azimuth + alpha_0
+        return [thrust, thrust, alpha, alpha]
+
+    sim = model.simulate(x0, controller, h, n_steps=n_fine + 1, current=current)
+    idx = np.arange(n_samples) * m
+    states = sim.states[idx]
+    time = idx * h
+    azimuth = np.asarray(azimuths)[idx]
+    rpm = np.asarray(rpms)[idx]
+    psi, r = states[:, _rvg.IPSI], states[:, _rvg.IR]
+    x, y = states[:, _rvg.IX], states[:, _rvg.IY]
+    u, v = states[:, _rvg.IU], states[:, _rvg.IV]
+    if noise:
+        n = n_samples
+        psi = psi + NOISE["psi"] * rng_noise.standard_normal(n)
+        r = r + NOISE["r"] * rng_noise.standard_normal(n)
+        x = x + NOISE["xy"] * rng_noise.standard_normal(n)
+        y = y + NOISE["xy"] * rng_noise.standard_normal(n)
+        u = u + NOISE["uv"] * rng_noise.standard_normal(n)
+        v = v + NOISE["uv"] * rng_noise.standard_normal(n)
+
+    truth = {
+        "model": "rvg3dof",
+        "params": _rvg_params_dict(params),
+        "gear": None,
+        "surge": None,
+        "current": current.tolist(),
+        "x0": x0.tolist(),
+        "steady_relative_surge": u_r0,
+        "rpm_law": "shipgym.models.rvg.pod_thrust(rpm, u_r)",
+        "base_model": "rvg3dof",
+        "base_params": _rvg_params_dict(base),
+        "effect": effect,
+        "effect_params": effect_params,
+        "magnitude": magnitude,
+        "fine_step": h,
+    }
+    meta = {
+        "source": "shipgym.sysid.generator",
+        "vessel": "R/V Gunnerus (RVG 3-DOF model, seed 001)",
+        "L": _rvg.LPP,
+        "scale": "full",
+        "frame": "x north, y east [m] from the start position",
+        "r_source": "measured",
+        "maneuver": maneuver,
+        "dt": dt,
+        "seed": int(seed),
+        "noise": {k: NOISE[k] for k in _NOISE_KEYS["rvg3dof"]} if noise else None,
+        "conversions": [
+            "delta = -azimuth (both pods steer together; positive azimuth turns to port)"
+        ],
+        "repairs": [],
+        "notes": [
+            "synthetic record; meta['truth'] is the ground truth for tests only and must not be "
+            "read by an identifier",
+            "azimuth and rpm are commands (orders) of both pods, noise-free: the pods lag them",
+            "u, v are body-frame velocities over ground (include current); U = hypot(u, v)",
+        ],
+        "truth": truth,
+    }
+    return Record(
+        time=time,
+        delta=-azimuth,
+        psi=psi,
+        r=r,
+        x=x,
+        y=y,
+        u=u,
+        v=v,
+        U=np.hypot(u, v),
+        azimuth=azimuth,
+        rpm=rpm,
+        meta=meta,
+    )
