@@ -9,9 +9,12 @@ Subcommands::
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
     shipgym evaluate --env ID [--controller classic|zero] [--episodes N] [--seed S]
                      [--json OUT] [--plot DIR]
+    shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
+                     [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
+                     [--max-effects N] [--quiet]
 
 Each subcommand is registered by a builder in ``SUBCOMMANDS`` (name -> function that adds its
-parser and sets ``handler``), so later subcommands (identify, train, benchmark) plug in with
+parser and sets ``handler``), so later subcommands (train, benchmark) plug in with
 one entry. Bad input ends with a one-line message and exit code 2
 (argparse's own message for bad arguments, ``shipgym: error: ...`` for a ``ValueError`` raised
 by the library), never a traceback. Heavy imports happen inside the handlers, so
@@ -21,8 +24,10 @@ by the library), never a traceback. Heavy imports happen inside the handlers, so
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 PROG = "shipgym"
@@ -453,7 +458,6 @@ def _build_simulate(sub: Any) -> None:
     p.set_defaults(handler=_run_simulate)
 
 
-#: Subcommand name -> builder. Planned: identify, train, benchmark.
 # ------------------------------------------------------------------------------------------
 # evaluate
 # ------------------------------------------------------------------------------------------
@@ -522,12 +526,435 @@ def _build_evaluate(sub: Any) -> None:
     p.set_defaults(handler=_run_evaluate)
 
 
+# ------------------------------------------------------------------------------------------
+# identify
+# ------------------------------------------------------------------------------------------
+# parameter name -> unit (the Nomoto family and the effects' own parameters; others unitless)
+_PARAM_UNITS: dict[str, str] = {
+    "K": "1/s",
+    "T": "s",
+    "T1": "s",
+    "T2": "s",
+    "T3": "s",
+    "T_d": "s",
+    "tau": "s",
+    "delta0": "rad",
+    "b0": "rad",
+    "alpha_0": "rad",
+    "n0": "rad/s",
+    "n1": "-",
+    "n2": "s",
+    "n3": "s^2",
+    "b1": "s",
+    "b2": "s^2",
+    "b3": "s^3",
+    "V_n": "m/s",
+    "V_e": "m/s",
+    "speed": "m/s",
+}
+
+
+def _window(text: str) -> float | str | None:
+    """``--window``: a positive number of seconds, ``auto`` or ``none``."""
+    word = text.strip().lower()
+    if word in ("auto", "none"):
+        return None if word == "none" else "auto"
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(
+            f"must be a positive number of seconds, 'auto' or 'none', got {text!r}"
+        )
+    return value
+
+
+def _nonnegative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}")
+    return value
+
+
+def _output_path(text: str | None, flag: str, suffix: str | None = None) -> Path | None:
+    """Check an output file name before the (possibly long) run; ``-`` and None pass."""
+    if text is None or text == "-":
+        return None
+    path = Path(text)
+    if suffix is not None and path.suffix.lower() != suffix:
+        raise ValueError(f"{flag} must name a {suffix} file, got {text!r}")
+    if path.is_dir():
+        raise ValueError(f"{flag} names a directory, expected a file: {text!r}")
+    if not path.parent.is_dir():
+        raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
+    return path
+
+
+def _write_atomically(outputs: Sequence[tuple[Path, Callable[[Path], Any]]]) -> None:
+    """Write every ``(target, writer)`` to a temporary file next to it, then rename them all.
+
+    A failure in any writer leaves no output (and no temporary file) behind.
+    """
+    import os
+    import uuid
+
+    temps: list[tuple[Path, Path]] = []
+    try:
+        for target, write in outputs:
+            tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:8]}.tmp{target.suffix}")
+            temps.append((tmp, target))
+            write(tmp)
+        for tmp, target in temps:
+            os.replace(tmp, target)
+    finally:
+        for tmp, _ in temps:
+            tmp.unlink(missing_ok=True)
+
+
+def _format_value(name: str, value: Any, digits: int = 6, unit: bool = False) -> str:
+    """``value`` with ``digits`` significant digits; angles [rad] also in degrees.
+
+    ``unit``: append the unit of :data:`_PARAM_UNITS` (before the degrees).
+    """
+    if value is None:
+        return "n/a"
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return str(value)
+    text = f"{value:.{digits}g}"
+    known = _PARAM_UNITS.get(name)
+    if unit and known:
+        text += f" {known}"
+    if known == "rad" and math.isfinite(value):
+        text += f" ({math.degrees(value):.4g} deg)"
+    return text
+
+
+def _param_label(name: str) -> str:
+    unit = _PARAM_UNITS.get(name)
+    return f"{name} [{unit}]" if unit else name
+
+
+# record channel -> (unit shown, scale from SI) for per-channel evidence dicts
+_CHANNEL_UNITS: dict[str, tuple[str, float]] = {
+    "psi": ("deg", math.degrees(1.0)),
+    "r": ("deg/s", math.degrees(1.0)),
+    "u": ("m/s", 1.0),
+    "v": ("m/s", 1.0),
+    "x": ("m", 1.0),
+    "y": ("m", 1.0),
+}
+
+
+def _format_pair(stem: str, before: Any, after: Any) -> str:
+    """``"held-out psi RMS 3.701 -> 0.1023 deg"``; per-channel dicts give one item each."""
+    from shipgym.sysid.plots import METRIC_LABELS
+
+    where = "held-out " if stem.startswith("heldout_") else ""
+    metric = stem.removeprefix("heldout_")
+    if isinstance(before, dict) and isinstance(after, dict):  # {channel: value [SI]}
+        items = []
+        for ch in [*before, *(k for k in after if k not in before)]:
+            unit, scale = _CHANNEL_UNITS.get(ch, ("", 1.0))
+            b, a = before.get(ch), after.get(ch)
+            b = b * scale if isinstance(b, int | float) else b
+            a = a * scale if isinstance(a, int | float) else a
+            items.append(
+                f"{ch} {_format_value(ch, b, 4)} -> {_format_value(ch, a, 4)} {unit}".rstrip()
+            )
+        return f"{where}{metric.replace('_', ' ')}: " + ", ".join(items)
+    label, unit = METRIC_LABELS.get(metric, (metric, ""))
+    return (
+        f"{where}{label} {_format_value(metric, before, 4)} -> "
+        f"{_format_value(metric, after, 4)} {unit}".rstrip()
+    )
+
+
+def _format_evidence(evidence: dict[str, Any]) -> str:
+    """One line per effect: BIC change, held-out metrics before -> after, other numbers."""
+    parts = []
+    done = set()
+    if isinstance(evidence.get("delta_J"), int | float):
+        parts.append(f"BIC change {evidence['delta_J']:+.1f}")
+        done.add("delta_J")
+    if isinstance(evidence.get("relative_drop"), int | float):
+        parts.append(f"held-out RMS drop {100.0 * evidence['relative_drop']:.1f} %")
+        done.add("relative_drop")
+    for key in evidence:
+        stem = key.removesuffix("_before")
+        if key in done or stem == key or stem + "_after" not in evidence:
+            continue
+        parts.append(_format_pair(stem, evidence[key], evidence[stem + "_after"]))
+        done |= {key, stem + "_after"}
+    names = {"t_stat": "drift t statistic"}
+    for key, value in evidence.items():
+        if key not in done:
+            parts.append(f"{names.get(key, key)} {_format_value(key, value, 4, unit=True)}")
+    return "; ".join(parts)
+
+
+def _identify_summary(result: Any, source: str) -> str:
+    """The readable report of ``shipgym identify`` (the JSON holds the same numbers)."""
+    from shipgym.sysid.plots import METRIC_LABELS, format_errors
+
+    lines = [f"shipgym identify {source}", f"model: {result.model}"]
+    starts = result.traces.get("window_starts", [0]) if result.traces else [0]
+    if result.window_s is None:
+        how = "one free run from the estimated initial state"
+    else:
+        how = (
+            f"{len(starts)} consecutive windows of {result.window_s:g} s, each started from the "
+            "measured state"
+        )
+    lines.append(f"window: {'none' if result.window_s is None else f'{result.window_s:g} s'}")
+    lines.append(f"simulation error over the whole record ({how}):")
+    before, after = result.error_before, result.error_after
+    keys = [*before, *(k for k in after if k not in before)]
+    rows = [("", "before", "after")]
+    for key in keys:
+        label, unit = METRIC_LABELS.get(key, (key, ""))
+        rows.append(
+            (
+                f"{label} [{unit}]" if unit else label,
+                _format_value(key, before.get(key), 4),
+                _format_value(key, after.get(key), 4),
+            )
+        )
+    lines.extend(_table(rows))
+    if result.effects:
+        lines.append("effects added, in order:")
+        for i, effect in enumerate(result.effects, start=1):
+            params = ", ".join(
+                f"{k} = {_format_value(k, v, unit=True)}"
+                for k, v in effect.get("parameters", {}).items()
+            )
+            lines.append(f"  {i}. {effect['name']}: {params}")
+            lines.append(f"     evidence: {_format_evidence(effect.get('evidence', {}))}")
+    else:
+        lines.append("effects added: none (no candidate was significant on the held-out part)")
+    p_before, p_after = result.parameters_before, result.parameters_after
+    lines.append("parameters:")
+    rows = [("", "before", "after")]
+    for name in [*p_before, *(k for k in p_after if k not in p_before)]:
+        rows.append(
+            (
+                _param_label(name),
+                _format_value(name, p_before[name]) if name in p_before else "-",
+                _format_value(name, p_after[name]) if name in p_after else "-",
+            )
+        )
+    lines.extend(_table(rows))
+    held = result.heldout or {}
+    if held.get("error_before") is not None and held.get("error_after") is not None:
+        lines.append(
+            f"held-out part from {held.get('from_s', math.nan):.1f} s (models fitted on the "
+            f"rest): {format_errors(held['error_before'], held['error_after'])}"
+        )
+    for key, errors in held.items():  # further reference errors, e.g. of published parameters
+        if key.startswith("error_") and key not in ("error_before", "error_after"):
+            if isinstance(errors, dict):
+                text = ", ".join(
+                    f"{METRIC_LABELS.get(k, (k, ''))[0]} {_format_value(k, v, 4)} "
+                    f"{METRIC_LABELS.get(k, (k, ''))[1]}".rstrip()
+                    for k, v in errors.items()
+                )
+                lines.append(f"  held-out error of {key.removeprefix('error_')}: {text}")
+    lines.append(f"runtime: {result.runtime_s:.1f} s")
+    return "\n".join(lines)
+
+
+def _table(rows: Sequence[tuple[str, ...]], indent: str = "  ") -> list[str]:
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    out = []
+    for r in rows:
+        first = r[0].ljust(widths[0])
+        rest = [c.rjust(w) for c, w in zip(r[1:], widths[1:], strict=True)]
+        out.append((indent + "  ".join([first, *rest])).rstrip())
+    return out
+
+
+def _load_for_identify(path_text: str, fmt: str | None, note: Callable[[str], None]) -> Any:
+    """Load the record; repairs (:class:`SysidDataWarning`) and other warnings become notes."""
+    import warnings
+
+    from shipgym.sysid.data import FORMATS, detect_format, load
+
+    path = Path(path_text)
+    if not path.exists():
+        raise ValueError(
+            f"record file {path_text!r} does not exist (expected a measured-data file in one of "
+            f"the formats {', '.join(FORMATS)})"
+        )
+    if not path.is_file():
+        raise ValueError(f"{path_text!r} is not a file (expected a measured-data record file)")
+    if fmt is None:
+        try:
+            fmt = detect_format(path)
+        except ValueError as exc:
+            raise ValueError(
+                f"{str(exc).removesuffix(' (pass format=...)')}; pass --format"
+            ) from None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        record = load(path, fmt)
+    messages = [str(w.message) for w in caught]
+    for msg in messages:
+        note(msg)
+    if fmt == "canonical":  # repairs made before the record was written are not re-warned
+        for repair in record.meta.get("repairs", []):
+            if not any(str(repair) in msg for msg in messages):
+                note(f"repaired before it was written: {repair}")
+    return record, fmt
+
+
+def _run_identify(args: argparse.Namespace) -> int:
+    import json
+    import time
+    import warnings
+
+    from shipgym.sysid.effects import identify
+    from shipgym.sysid.fit import SysidWarning
+
+    json_path = _output_path(args.json, "--json")
+    plot_path = _output_path(args.plot, "--plot", ".png")
+    report = sys.stderr if args.json == "-" else sys.stdout
+    t0 = time.perf_counter()
+
+    def note(msg: str) -> None:
+        print(f"note: {msg}", file=sys.stderr, flush=True)
+
+    def progress(msg: str) -> None:
+        print(f"[{time.perf_counter() - t0:6.1f} s] {msg}", file=sys.stderr, flush=True)
+
+    say = (lambda _msg: None) if args.quiet else progress
+    say(f"loading {args.path} ...")
+    record, fmt = _load_for_identify(args.path, args.format, note)
+    chans = " ".join(k for k in record.channels() if k != "time")
+    source = (
+        f"{args.path} ({fmt}, {record.n} samples, {record.duration:g} s at dt "
+        f"{record.dt:g} s; channels {chans})"
+    )
+    say(f"loaded {source}")
+    window = {None: "none", "auto": "auto"}.get(args.window) or f"{args.window:g} s"
+    say(
+        f"identifying base {args.model} (holdout {args.holdout:g}, at most {args.max_effects} "
+        f"effects, window {window}) ..."
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SysidWarning)
+        try:
+            result = identify(
+                record,
+                args.model,
+                holdout=args.holdout,
+                max_effects=args.max_effects,
+                window_s=args.window,
+                progress=None if args.quiet else progress,
+            )
+        except ValueError as exc:
+            raise ValueError(f"cannot identify {args.model} from {args.path}: {exc}") from exc
+    for msg in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught):
+        note(msg)
+    say(f"done in {result.runtime_s:.1f} s")
+
+    print(_identify_summary(result, source), file=report, flush=True)
+    document = result.to_dict()
+    text = json.dumps(document, indent=2, allow_nan=False) + "\n"
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = []
+    if json_path is not None:
+        outputs.append((json_path, lambda p: p.write_text(text, encoding="utf-8")))
+    if plot_path is not None:
+        from shipgym.sysid.plots import plot_identification
+
+        outputs.append((plot_path, lambda p: plot_identification(result, p)))
+    _write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}", file=report)
+    if args.json == "-":
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    return 0
+
+
+def _build_identify(sub: Any) -> None:
+    from shipgym.sysid.data import FORMATS
+    from shipgym.sysid.effects import BASES
+
+    p = sub.add_parser(
+        "identify",
+        help="fit a model to a measured record and add the effects its residual points to",
+        description=(
+            "Load a manoeuvre record (any of the measured-data formats or the canonical CSV), "
+            "fit the base model by output error, then add effects of the catalogue (rudder "
+            "offset, yaw nonlinearity, rudder lag, input delay, current, second order; for "
+            "rvg3dof its own catalogue) one at a time while the BIC on the held-out end of the "
+            "record improves. Prints the simulation errors before and after (heading, yaw "
+            "rate, and position / speed where recorded), the effects with their parameters and "
+            "evidence, and the parameters. Progress and data-repair notes go to stderr."
+        ),
+    )
+    p.add_argument("path", metavar="PATH", help="record file")
+    p.add_argument(
+        "--format",
+        default=None,
+        choices=FORMATS,
+        help="file format (default: detected from the header and the file name)",
+    )
+    p.add_argument("--model", default="nomoto1", choices=BASES, help="base model (%(default)s)")
+    p.add_argument(
+        "--json",
+        default=None,
+        metavar="OUT",
+        help="write the result as JSON ('-': to stdout, the summary then goes to stderr)",
+    )
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="OUT.png",
+        help="write measured vs before vs after and the residuals as a PNG",
+    )
+    p.add_argument(
+        "--window",
+        type=_window,
+        default="auto",
+        metavar="S|auto|none",
+        help="score the errors over consecutive windows of S seconds, each started from the "
+        "measured state; 'none': one free run; 'auto' (default): windows for long records",
+    )
+    p.add_argument(
+        "--holdout",
+        type=_finite_float,
+        default=0.3,
+        metavar="FRAC",
+        help="fraction at the end of the record kept out of the fits for scoring "
+        "(default: %(default)s)",
+    )
+    p.add_argument(
+        "--max-effects",
+        type=_nonnegative_int,
+        default=3,
+        metavar="N",
+        help="largest number of effects to add (default: %(default)s)",
+    )
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress lines (notes, errors and the summary are still printed)",
+    )
+    p.set_defaults(handler=_run_identify)
+
+
+#: Subcommand name -> builder. Planned: train, benchmark.
 SUBCOMMANDS: dict[str, Builder] = {
     "demo": _build_demo,
     "bench": _build_bench,
     "envs": _build_envs,
     "simulate": _build_simulate,
     "evaluate": _build_evaluate,
+    "identify": _build_identify,
 }
 
 

@@ -248,8 +248,8 @@ def _held(rec: Record, seconds: float) -> np.ndarray:
 
 def test_effect_catalogue_per_base() -> None:
     assert BASE_MODELS == ("nomoto1", "rvg3dof")
-    assert _RVG_EFFECTS == ("thruster_lift", "azimuth_offset", "current")
-    assert EFFECTS == (*_NOMOTO_EFFECTS, "thruster_lift", "azimuth_offset")
+    assert _RVG_EFFECTS == ("thruster_lift", "azimuth_offset", "current", "sway_offset")
+    assert EFFECTS == (*_NOMOTO_EFFECTS, "thruster_lift", "azimuth_offset", "sway_offset")
     assert set(EFFECT_DEFAULTS) == set(EFFECTS)
     assert EFFECT_DEFAULTS["thruster_lift"] == pytest.approx(6.48e3, rel=0.01)
     assert EFFECT_DEFAULTS["azimuth_offset"] == pytest.approx(math.radians(2.0))
@@ -314,6 +314,15 @@ def test_rvg_random_commands() -> None:
     assert np.max(np.diff(rpm_switch)) <= RVG_RPM_HOLD[1] + rec.dt
     # the rpm changes make the speed vary (what separates foil lift from thrust)
     assert np.ptp(rec.u) > 1.0
+
+
+def test_rvg_sway_offset_shifts_only_the_recorded_transverse_speed() -> None:
+    clean = _rvg(maneuver="random", duration=200.0, noise=False, seed=4)
+    rec = _rvg("sway_offset", maneuver="random", duration=200.0, noise=False, seed=4)
+    np.testing.assert_allclose(rec.v - clean.v, 0.2, atol=1e-12)
+    for ch in ("psi", "r", "x", "y", "u", "azimuth", "rpm"):
+        np.testing.assert_array_equal(getattr(rec, ch), getattr(clean, ch))
+    np.testing.assert_allclose(rec.U, np.hypot(rec.u, rec.v))
 
 
 @pytest.mark.parametrize("maneuver", ["zigzag", "random"])
@@ -432,6 +441,7 @@ def test_rvg_noise_on_measurements_only(effect: str | None) -> None:
         ("thruster_lift", 3.0e3, {"c_L": 3.0e3}),
         ("azimuth_offset", -0.05, {"alpha_0": -0.05}),
         ("current", 0.3, {"speed": 0.3}),
+        ("sway_offset", 0.15, {"v_0": 0.15}),
     ],
 )
 def test_rvg_truth(effect: str | None, magnitude: float | None, expected: dict) -> None:

@@ -71,6 +71,10 @@ effect              definition
                     (seed 001 eq. 7-12: it enters the kinetics through the relative velocity
                     ``nu_r = nu - nu_c`` and the propeller law through ``u_r``). The recorded
                     ``u``, ``v`` are ground velocities, as in the sea trial.
+``sway_offset``     The recorded transverse speed carries an offset ``v_0`` [m/s] (0.2 m/s):
+                    a speed-log or GNSS-antenna misalignment, as the Gunnerus record's
+                    +0.2 m/s on straight runs on every heading (SOURCES.md oddity 3). The
+                    ship is the clean one; only the recorded ``v`` (and ``U``) differ.
 =================== ===========================================================================
 
 Manoeuvres (``maneuver``):
@@ -178,7 +182,7 @@ EFFECTS_BY_BASE: dict[str, tuple[str, ...]] = {
         "current",
         "second_order",
     ),
-    "rvg3dof": ("thruster_lift", "azimuth_offset", "current"),
+    "rvg3dof": ("thruster_lift", "azimuth_offset", "current", "sway_offset"),
 }
 """The undeclared effects defined for each base model (see the module docstring)."""
 
@@ -197,6 +201,7 @@ EFFECT_DEFAULTS: dict[str, float] = {
     "second_order": 7.8,  # T2 [s]
     "thruster_lift": _rvg.POD_LIFT_COEFFICIENT_THRUSTER_DATA,  # c_L [N s^2/m^2]
     "azimuth_offset": math.radians(2.0),  # alpha_0 [rad]
+    "sway_offset": 0.2,  # v_0 [m/s]
 }
 """Default ``magnitude`` of each effect, in the unit of the module docstring's tables."""
 
@@ -601,6 +606,9 @@ def _rvg_record(
     elif effect == "current":
         assert magnitude is not None
         current, effect_params = _draw_current(rng_cur, magnitude)
+    elif effect == "sway_offset":
+        assert magnitude is not None
+        effect_params = {"v_0": magnitude}
     model = make_model("rvg3dof", params)
     p = model.p
     t_end = (n_fine + 1) * h
@@ -665,6 +673,8 @@ def _rvg_record(
     psi, r = states[:, _rvg.IPSI], states[:, _rvg.IR]
     x, y = states[:, _rvg.IX], states[:, _rvg.IY]
     u, v = states[:, _rvg.IU], states[:, _rvg.IV]
+    if effect == "sway_offset":
+        v = v + effect_params["v_0"]
     if noise:
         n = n_samples
         psi = psi + NOISE["psi"] * rng_noise.standard_normal(n)
