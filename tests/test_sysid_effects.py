@@ -117,3 +117,23 @@ def test_progress_and_validation() -> None:
     short = Record(time=rec.time[:50], delta=rec.delta[:50], psi=rec.psi[:50], r=rec.r[:50])
     with pytest.raises(ValueError, match="too short"):
         identify(short)
+
+
+def test_lag_filter_is_the_ship_model_steering_gear() -> None:
+    """The compiled ``_lag_filter`` takes the steps of ``ShipModel.simulate`` exactly."""
+    from shipgym.models import Nomoto1Params, SteeringGear, make_model
+    from shipgym.models.nomoto import IDELTA
+    from shipgym.sysid.effects import _lag_filter
+
+    rec = _record("rudder_lag")
+    t, d = rec.time, rec.delta
+    model = make_model("nomoto1", Nomoto1Params(), gear=SteeringGear(time_constant=8.0))
+    h = DT / math.ceil(DT / 0.1 - 1e-9)
+    tf = t[0] + h * np.arange(round((t[-1] - t[0]) / h) + 1)
+    inputs = np.zeros((tf.size - 1, model.nu))
+    inputs[:, 0] = np.interp(tf[:-1], t, d)
+    x0 = np.zeros(model.nx)
+    x0[IDELTA] = 0.01
+    sim = model.simulate(x0, inputs, h)
+    expected = np.interp(t, tf, sim.states[:, IDELTA])
+    np.testing.assert_array_equal(_lag_filter(t, d, 8.0, 0.01), expected)

@@ -260,3 +260,61 @@ def test_nomoto2_fit_with_a_rudder_offset_estimates_it() -> None:
     truth = rec.meta["truth"]["effect_params"]
     # the generator's ship obeys T r' + r = K (delta - delta_0); the fit replays delta + delta0
     assert res.delta0 == pytest.approx(-truth["delta_0"], rel=0.1)
+
+
+def test_output_error_warm_start_from_a_fit_converges_at_once() -> None:
+    """``init``, ``x0`` and ``init_delta0`` from a fit restart it at its optimum."""
+    from shipgym.sysid import generate_record
+
+    rec = generate_record("rudder_offset", maneuver="zigzag", dt=0.5, seed=0)
+    sigma = (1e-3, 1e-4)
+    args = (rec.time, rec.delta, rec.psi, rec.r, "nomoto1")
+    cold = fit_output_error(*args, bias=True, sigma=sigma)
+    warm = fit_output_error(
+        *args, bias=True, sigma=sigma, init=cold.params, x0=cold.x0, init_delta0=cold.delta0
+    )
+    assert warm.info["nfev"] <= 3 < cold.info["nfev"]
+    for k in ("K", "T", "delta0", "psi0", "r0"):
+        assert warm.values[k] == pytest.approx(cold.values[k], rel=1e-4, abs=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("name", "params"),
+    [
+        ("nomoto1", Nomoto1Params()),
+        ("nomoto2", Nomoto2Params()),
+        ("norrbin", NorrbinParams(n3=2.9e3)),
+        ("bech", BechParams()),
+    ],
+)
+def test_replay_is_the_shared_rk4_step(name, params) -> None:
+    """The per-model compiled replay takes exactly the steps of ``integrate.rk4_step``."""
+    from shipgym.models.base import MODEL_NAMES
+    from shipgym.models.integrate import rk4_step
+    from shipgym.models.nomoto import pack_nomoto
+    from shipgym.sysid.fit import _REPLAY_GEAR, _REPLAY_SURGE, _REPLAY_TC
+
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.2, 0.6, 300))
+    delta = np.repeat(rng.uniform(-0.3, 0.3, 30), 10)
+    speed = 5.0 + 0.1 * np.sin(t / 20.0)
+    nx = 7 if name in ("nomoto2", "bech") else 6
+    x = np.zeros((1, nx))
+    x[0, 4] = 0.01
+    sim = replay(name, params, t, delta, x[0], speed)
+    p = pack_nomoto(params, _REPLAY_GEAR, _REPLAY_SURGE)
+    expected = [x[0].copy()]
+    for k in range(t.size - 1):
+        h = t[k + 1] - t[k]
+        x[0, 5], x[0, 3] = delta[k], speed[k]  # rudder and speed states (IDELTA, IU)
+        u = np.array(
+            [
+                [
+                    delta[k] + _REPLAY_TC * (delta[k + 1] - delta[k]) / h,
+                    speed[k] + _REPLAY_TC * (speed[k + 1] - speed[k]) / h,
+                ]
+            ]
+        )
+        rk4_step(MODEL_NAMES.index(name), x, u, p, np.zeros((1, 2)), h)
+        expected.append(x[0].copy())
+    np.testing.assert_array_equal(sim, np.array(expected))

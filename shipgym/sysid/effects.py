@@ -22,8 +22,9 @@ Augmented models (all simulated by :mod:`shipgym.models` through ``replay``):
 * ``second_order``: the second-order Nomoto model (seed 004 eq. 1);
 * ``rudder_lag``: the recorded rudder is taken as the COMMAND of the project's steering gear
   (:class:`shipgym.models.SteeringGear`, seed 002 eq. 2: first-order, time constant ``T_d``,
-  default 35 deg / 2.32 deg/s limits), simulated by :meth:`ShipModel.simulate`; ``T_d`` by a
-  grid plus bounded 1-D search around the output-error fit. The gear's initial angle is
+  default 35 deg / 2.32 deg/s limits), simulated with the RK4 steps of
+  :meth:`ShipModel.simulate` (compiled); ``T_d`` by a grid plus bounded 1-D search around the
+  output-error fit. The gear's initial angle is
   estimated from the base fit and the initial yaw acceleration (``(T r'(0) + r(0)) / K``);
 * ``input_delay``: the recorded rudder shifted by ``tau`` (linear interpolation, first sample
   held before the start), ``tau`` by a bounded 1-D search;
@@ -67,6 +68,16 @@ reckoning (with and without drift, two extra parameters), and the drift must als
 negative ``J`` change wins; the yaw score and the position score are both log-likelihood ratios,
 so they are compared directly.
 
+Cost
+----
+Each ``T_d`` or ``tau`` value tried is a full output-error fit. The fits inside a search run on
+a decimated copy of the segment (at most :data:`_SEARCH_SAMPLES` samples; the input is shifted
+and filtered on the full grid first), each starts from the converged fit at the nearest value
+tried, and only the reweighted fit at the chosen value uses every sample. A candidate that a
+round has already fitted (after ``current`` is accepted the yaw model is unchanged) and the
+``tau`` search of a lag-and-delay candidate (the delay is searched with the lag off) are not
+repeated. A 10 000-sample record takes a few seconds.
+
 The ground truth that :mod:`shipgym.sysid.generator` stores in ``meta["truth"]`` is never read.
 """
 
@@ -85,6 +96,8 @@ from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
 from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
+from shipgym.models._jit import kernel
+from shipgym.models.integrate import NOMOTO1, rk4_row
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 from shipgym.sysid.fit import (
@@ -119,7 +132,7 @@ NOMOTO_CATALOGUE: tuple[str, ...] = (
 )
 """Effects the loop can add to a Nomoto-family base."""
 
-RVG_CATALOGUE: tuple[str, ...] = ("thruster_lift", "azimuth_offset", "current")
+RVG_CATALOGUE: tuple[str, ...] = ("thruster_lift", "azimuth_offset", "current", "sway_offset")
 """Effects the loop can add to the ``rvg3dof`` base (:mod:`shipgym.sysid.rvg_identify`)."""
 
 CATALOGUE: tuple[str, ...] = NOMOTO_CATALOGUE + tuple(
@@ -169,6 +182,17 @@ AUTO_WINDOW_S = 300.0
 """Window [s] for long Nomoto-family records (``window_s="auto"``)."""
 _LAG_BOUNDS = (0.1, 40.0)
 _DELAY_BOUNDS = (0.0, 15.0)
+_SEARCH_SAMPLES = 2000
+"""Largest number of samples of the fits inside the ``T_d`` / ``tau`` searches."""
+_SEARCH_XATOL = 0.05
+"""Coarsest tolerance [s] of the Brent step of the ``T_d`` / ``tau`` searches (else 0.05 dt)."""
+_SEARCH_NFEV = 60
+"""Budget (``max_nfev``) of each fit inside the ``T_d`` / ``tau`` searches."""
+_FIT_NFEV = 200
+"""Budget of each pass of the candidates' reweighted fits (``max_nfev``; converging fits
+take 5 to 50)."""
+_POLISH_NFEV = 100
+"""Budget of the second pass on every sample of a segment longer than :data:`_SEARCH_SAMPLES`."""
 _LJUNG_BOX_LAGS = 20
 _XCORR_LAGS = (0, 2, 5, 10, 20, 40)
 
@@ -230,13 +254,35 @@ class _Fitted:
         return out
 
 
+@kernel
+def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
+    """:meth:`ShipModel.simulate` of a ``nomoto1`` model with inputs ``(cmd[k], 0)``, compiled.
+
+    The same RK4 steps (:func:`shipgym.models.integrate.rk4_row`, no current); writes the
+    rudder state ``x[IDELTA]`` at every step into ``out`` (length ``cmd.size + 1``).
+    """
+    nx = x0.shape[0]
+    x = np.empty((1, nx))
+    for j in range(nx):
+        x[0, j] = x0[j]
+    u = np.zeros((1, 2))
+    c = np.zeros((1, 2))
+    work = np.empty((5, nx))
+    out[0] = x[0, IDELTA]
+    for k in range(cmd.shape[0]):
+        u[0, 0] = cmd[k]
+        rk4_row(NOMOTO1, x, u, p, c, h, 0, work[0], work[1], work[2], work[3], work[4])
+        out[k + 1] = x[0, IDELTA]
+
+
 def _lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = None) -> np.ndarray:
     """The recorded rudder ``u`` as a command through the project's steering gear.
 
     :class:`shipgym.models.SteeringGear` with time constant ``T_d`` and the default angle and
-    rate limits (35 deg, 2.32 deg/s, seed 002 eq. 2), simulated by :meth:`ShipModel.simulate`
-    on a fine grid (step at most 0.1 s, the command held over each step) and read back at
-    ``t``; the initial actual rudder is ``y0`` (``u(0)`` by default).
+    rate limits (35 deg, 2.32 deg/s, seed 002 eq. 2), simulated with the steps of
+    :meth:`ShipModel.simulate` (compiled, :func:`_gear_kernel`) on a fine grid (step at most
+    0.1 s, the command held over each step) and read back at ``t``; the initial actual rudder
+    is ``y0`` (``u(0)`` by default).
     """
     dt = float(np.median(np.diff(t)))
     m = max(1, math.ceil(dt / 0.1 - 1e-9))
@@ -244,12 +290,11 @@ def _lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = Non
     n = max(1, math.ceil((t[-1] - t[0]) / h - 1e-9))
     tf = t[0] + h * np.arange(n + 1)
     model = make_model("nomoto1", Nomoto1Params(), gear=SteeringGear(time_constant=T_d))
-    inputs = np.zeros((n, model.nu))
-    inputs[:, 0] = np.interp(tf[:-1], t, u)
     x0 = np.zeros(model.nx)
     x0[IDELTA] = u[0] if y0 is None else y0
-    sim = model.simulate(x0, inputs, h)
-    return np.interp(t, tf, sim.states[:, IDELTA])
+    rudder = np.empty(n + 1)
+    _gear_kernel(x0, np.interp(tf[:-1], t, u), model.p, h, rudder)
+    return np.interp(t, tf, rudder)
 
 
 def _initial_rudder(fit: FitResult, t: np.ndarray, r: np.ndarray) -> float:
@@ -301,24 +346,51 @@ def _fit_config(
     sigma: tuple[float, float],
     U: np.ndarray | None,
     y0: float | None = None,
+    memo: dict[Any, tuple[float, FitResult]] | None = None,
 ) -> _Fitted:
-    """Output-error fit of a configuration on one segment (1-D searches for ``T_d``, ``tau``)."""
+    """Output-error fit of a configuration on one segment (1-D searches for ``T_d``, ``tau``).
 
-    def fit_with(T_d: float, tau: float, reweight: bool) -> FitResult:
+    The result is the reweighted fit of :func:`fit_output_error` (a first pass with the
+    signals' standard deviations as noise levels, a second with the first pass's residual
+    RMS). The work is cut three ways, none of which changes the criterion:
+
+    * long segments: the search fits and the first pass run on every ``step``-th sample (at
+      most :data:`_SEARCH_SAMPLES`; the input is shifted and lag-filtered on the full grid
+      first, then decimated, so the first-order hold of the fit only interpolates a sampled
+      smooth rudder); the second pass uses every sample;
+    * warm starts: each search fit starts from the converged fit at the nearest value searched
+      so far, and the passes at the chosen value from the search fit there;
+    * ``memo`` (one dict per record) keeps the ``tau`` search, which does not depend on the lag
+      (a lag-and-delay candidate repeats the delay candidate's search).
+    """
+    step = max(1, math.ceil(t.size / _SEARCH_SAMPLES))
+    sub = slice(None, None, step)
+    full = slice(None)
+    U_full = np.ones_like(t) if U is None else U
+
+    def fit_with(
+        T_d: float, tau: float, sl: slice, kw: dict[str, Any], warm: FitResult | None
+    ) -> FitResult:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", SysidWarning)
             warnings.simplefilter("ignore", RuntimeWarning)
-            d_in = _input(cfg, t, delta, T_d, tau, y0)
-            kw: dict[str, Any] = {
-                "U": U,
-                "sigma": None if reweight else sigma,
-                "reweight": reweight,
-                "max_nfev": None if reweight else 60,
-            }
+            d_in = _input(cfg, t, delta, T_d, tau, y0)[sl]
+            seg = (t[sl], d_in, psi[sl], r[sl])
+            kw = {**kw, "U": U_full[sl]}
+            if warm is not None:
+                return fit_output_error(
+                    *seg,
+                    cfg.model,
+                    bias=cfg.bias,
+                    init=warm.params,
+                    x0=warm.x0,
+                    init_delta0=warm.delta0,
+                    **kw,
+                )
             if cfg.nonlinear:
                 # start the nonlinear model from the linear fit with its terms off: the
                 # equation-error start of a polynomial yaw model is fragile on short segments
-                lin = fit_with_model(_Config(**{**cfg.__dict__, "nonlinear": False}), d_in, kw)
+                lin = fit_with_model(_Config(**{**cfg.__dict__, "nonlinear": False}), seg, kw)
                 v = lin.values
                 if cfg.second:
                     init: Any = BechParams(
@@ -331,37 +403,79 @@ def _fit_config(
                         init = replace(init, b0=-lin.delta0)
                     else:
                         init = replace(init, n0=-lin.delta0 * v["K"])
-                return fit_output_error(t, d_in, psi, r, cfg.model, bias=cfg.bias, init=init, **kw)
-            return fit_with_model(cfg, d_in, kw)
+                return fit_output_error(*seg, cfg.model, bias=cfg.bias, init=init, **kw)
+            return fit_with_model(cfg, seg, kw)
 
-    def fit_with_model(c: _Config, d_in: np.ndarray, kw: dict[str, Any]) -> FitResult:
+    def fit_with_model(c: _Config, seg: tuple[np.ndarray, ...], kw: dict[str, Any]) -> FitResult:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore", SysidWarning)
             warnings.simplefilter("ignore", RuntimeWarning)
             try:
-                return fit_output_error(t, d_in, psi, r, c.model, bias=c.bias, **kw)
+                return fit_output_error(*seg, c.model, bias=c.bias, **kw)
             except TypeError:
                 # the equation-error start of fit.py fails for nomoto2 with a bias
                 # (Nomoto2Params gets a delta0 keyword): start from the fit without bias
                 if not c.bias:
                     raise
-                start = fit_output_error(t, d_in, psi, r, c.model, bias=False, **kw)
-                return fit_output_error(
-                    t, d_in, psi, r, c.model, bias=True, init=start.params, **kw
-                )
+                start = fit_output_error(*seg, c.model, bias=False, **kw)
+                return fit_output_error(*seg, c.model, bias=True, init=start.params, **kw)
+
+    search_kw = {"sigma": sigma, "reweight": False, "max_nfev": _SEARCH_NFEV}
+
+    def reweighted(T_d: float, tau: float, warm: FitResult | None) -> FitResult:
+        """``fit_output_error(..., reweight=True)``, its first pass decimated and warm."""
+        cold = {"reweight": True, "max_nfev": _FIT_NFEV}
+        if warm is None and step == 1:
+            return fit_with(T_d, tau, full, cold, None)
+        # first pass: the weights fit_output_error takes without sigma (whole segment)
+        equal = (max(float(np.std(psi)), 1e-6), max(float(np.std(r)), 1e-9))
+        kw = {"sigma": equal, "reweight": False, "max_nfev": _FIT_NFEV}
+        first = fit_with(T_d, tau, sub, kw, warm)
+        if warm is not None and not (math.isfinite(first.rms_psi) and math.isfinite(first.rms_r)):
+            # the start led to a diverging model: as without it
+            if step == 1:
+                return fit_with(T_d, tau, full, cold, None)
+            first = fit_with(T_d, tau, sub, kw, None)
+        # second pass: weights from the first pass's residual RMS, on every sample
+        second = {
+            "sigma": (max(first.rms_psi, 1e-12), max(first.rms_r, 1e-15)),
+            "reweight": False,
+            "max_nfev": _FIT_NFEV if step == 1 else _POLISH_NFEV,
+        }
+        return fit_with(T_d, tau, full, second, first)
 
     def cost(f: FitResult) -> float:
         return (f.rms_psi / sigma[0]) ** 2 + (f.rms_r / sigma[1]) ** 2
 
+    def search(
+        fit_at: Callable[[float, FitResult | None], FitResult], bounds: tuple[float, float]
+    ) -> tuple[float, FitResult]:
+        fits: dict[float, FitResult] = {}
+
+        def fun(s: float) -> float:
+            near = min(fits, key=lambda k: abs(k - s)) if fits else None
+            fits[s] = fit_at(s, None if near is None else fits[near])
+            return cost(fits[s])
+
+        best = _search(fun, bounds, t)
+        return best, fits[min(fits, key=lambda k: abs(k - best))]
+
     T_d, tau = 0.0, 0.0
+    warm: FitResult | None = None
     if cfg.lag or cfg.delay:
         # one scalar at a time (lag and delay are both an input phase lag: with both present
         # the delay is searched first with the lag off, then the lag with that delay)
         if cfg.delay:
-            tau = _search(lambda s: cost(fit_with(0.0, s, False)), _DELAY_BOUNDS, t)
+            key = (t.size, float(t[0]), cfg.model, cfg.bias)
+            if memo is not None and key in memo:
+                tau, warm = memo[key]
+            else:
+                tau, warm = search(lambda s, w: fit_with(0.0, s, sub, search_kw, w), _DELAY_BOUNDS)
+                if memo is not None:
+                    memo[key] = (tau, warm)
         if cfg.lag:
-            T_d = _search(lambda s: cost(fit_with(s, tau, False)), _LAG_BOUNDS, t)
-    return _Fitted(cfg, fit_with(T_d, tau, True), T_d, tau, y0)
+            T_d, warm = search(lambda s, w: fit_with(s, tau, sub, search_kw, w), _LAG_BOUNDS)
+    return _Fitted(cfg, reweighted(T_d, tau, warm), T_d, tau, y0)
 
 
 def _search(fun: Callable[[float], float], bounds: tuple[float, float], t: np.ndarray) -> float:
@@ -372,7 +486,7 @@ def _search(fun: Callable[[float], float], bounds: tuple[float, float], t: np.nd
     lo = grid[max(i - 1, 0)]
     hi = grid[min(i + 1, grid.size - 1)]
     dt = float(np.median(np.diff(t)))
-    opts = {"xatol": 0.05 * dt, "maxiter": 12}
+    opts = {"xatol": max(0.05 * dt, _SEARCH_XATOL), "maxiter": 12}
     sol = minimize_scalar(fun, bounds=(lo, hi), method="bounded", options=opts)
     return float(sol.x) if sol.fun <= vals[i] else float(grid[i])
 
@@ -528,8 +642,9 @@ def _report(
     """Simulated ``psi``, ``r`` (and ``x``, ``y``) of a Nomoto-family fit over the record.
 
     Whole record (``windowed`` False): one free run from the fit's estimated initial state.
-    Windowed: each window starts from the measured ``psi``, ``r`` (``r'`` from a Savitzky-Golay
-    derivative for second-order models) and position. Positions use the recorded speed and, for
+    Windowed: each window starts from the measured ``psi``, ``r`` (read off a quadratic
+    Savitzky-Golay fit over 11 samples, ``r'`` from its derivative for second-order models)
+    and position. Positions use the recorded speed and, for
     the ``current`` effect, the drift ``(V_n, V_e)``.
     """
     t = rec.time
@@ -537,15 +652,18 @@ def _report(
     has_xy = rec.x is not None and rec.y is not None and speed is not None
     nx = fit.x0.shape[0]
     out = {k: np.empty(t.size) for k in ("psi", "r", "x", "y")}
-    rd = None
-    if windowed and nx == 7:
-        w = min(11, t.size // 2 * 2 - 1)
-        rd = savgol_filter(rec.r, w, 2, deriv=1, delta=float(np.median(np.diff(t))))
+    # windows start from a local quadratic fit of the measured psi, r (and r') over 11
+    # samples: one noisy r sample would bend the whole window's heading by about T e
+    w = min(11, t.size // 2 * 2 - 1)
+    dt = float(np.median(np.diff(t)))
+    psi_s = savgol_filter(np.unwrap(rec.psi), w, 2) if windowed else rec.psi
+    r_s = savgol_filter(rec.r, w, 2) if windowed else rec.r
+    rd = savgol_filter(rec.r, w, 2, deriv=1, delta=dt) if windowed and nx == 7 else None
     bounds = [*starts.tolist(), t.size]
     for i0, i1 in itertools.pairwise(bounds):
         x0 = fit.x0.copy()
         if windowed:
-            x0[2], x0[4] = rec.psi[i0], rec.r[i0]
+            x0[2], x0[4] = psi_s[i0], r_s[i0]
             if rd is not None:
                 x0[6] = rd[i0]
         if has_xy:
@@ -939,6 +1057,8 @@ def identify(
     y0 = _initial_rudder(base_full, t, r)
     cfg = _Config(**_BASE_CONFIG[base])
     sigma = (max(base_full.rms_psi, 1e-6), max(base_full.rms_r, 1e-9))
+    memo: dict[Any, tuple[float, FitResult]] = {}
+    tried: dict[_Config, tuple[_Fitted, dict[str, float]] | Exception] = {}
     current_fit = _fit_config(cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None)
     current_score = base_score = _score(current_fit, t, delta, psi, r, split, sigma)
     say(f"base {base}: held-out psi {current_score['psi_rms_deg']:.3f} deg")
@@ -954,8 +1074,18 @@ def identify(
                 continue
             new_cfg = cfg.with_effect(name)
             try:
-                fitted = _fit_config(new_cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None, y0)
-                sc = _score(fitted, t, delta, psi, r, split, sigma)
+                if new_cfg not in tried:  # (accepting current leaves the yaw model as it was)
+                    try:
+                        fitted = _fit_config(
+                            new_cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None, y0, memo
+                        )
+                        tried[new_cfg] = (fitted, _score(fitted, t, delta, psi, r, split, sigma))
+                    except (ValueError, TypeError, np.linalg.LinAlgError) as exc:
+                        tried[new_cfg] = exc
+                outcome = tried[new_cfg]
+                if isinstance(outcome, Exception):
+                    raise outcome
+                fitted, sc = outcome[0], dict(outcome[1])
             except (ValueError, TypeError, np.linalg.LinAlgError) as exc:
                 say(f"  {name}: fit failed ({exc})")
                 candidates[name] = {
@@ -1051,7 +1181,10 @@ def identify(
         say(f"accepted {best}")
 
     # final fit on the whole record
-    final = _fit_config(cfg, t, delta, psi, r, sigma, None, y0)
+    if cfg == _Config(**_BASE_CONFIG[base]) and not cfg.nonlinear:
+        final = _Fitted(cfg, base_full)  # the same fit (the nonlinear bases start differently)
+    else:
+        final = _fit_config(cfg, t, delta, psi, r, sigma, None, y0, memo)
     d_final = _input(cfg, t, delta, final.T_d, final.tau, y0)
     diagnostics = {
         "base": residual_diagnostics(base_full, t, delta, psi, r),

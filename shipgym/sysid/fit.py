@@ -43,14 +43,15 @@ white measurement noise and are optimistic when the residual is dominated by mod
 
 **Rudder replay through the shared kernels.** The simulation runs
 :func:`shipgym.models.integrate.rk4_row` (the one model kernel and RK4 integrator) in a
-compiled loop over the record. At each sample the rudder state is set to the recorded
-``delta[k]`` and the steering gear is given a time constant of ``1e6`` s, no angle or rate
-limit and the command ``delta[k] + T_delta (delta[k+1] - delta[k]) / h``, so inside each
-step the rudder follows the straight line between the samples (first-order hold, relative
-error below ``h / 1e6``) and ``delta'`` (used by the ``T3`` term) is the slope of the record.
-The speed ``U`` is held at the recorded value the same way (surge gain 1, time constant
-``1e6`` s); it does not affect the yaw models. Irregular sampling is handled (the step is
-``t[k+1] - t[k]``). The fitted :meth:`FitResult.model` uses the real (given) gear and surge.
+loop over the record, compiled once per model so that the model dispatch folds away. At each
+sample the rudder state is set to the recorded ``delta[k]`` and the steering gear is given a
+time constant of ``1e6`` s, no angle or rate limit and the command
+``delta[k] + T_delta (delta[k+1] - delta[k]) / h``, so inside each step the rudder follows
+the straight line between the samples (first-order hold, relative error below ``h / 1e6``)
+and ``delta'`` (used by the ``T3`` term) is the slope of the record. The speed ``U`` is held
+at the recorded value the same way (surge gain 1, time constant ``1e6`` s); it does not
+affect the yaw models. Irregular sampling is handled (the step is ``t[k+1] - t[k]``). The
+fitted :meth:`FitResult.model` uses the real (given) gear and surge.
 """
 
 from __future__ import annotations
@@ -76,9 +77,9 @@ from shipgym.models import (
     SurgeModel,
     make_model,
 )
-from shipgym.models._jit import kernel
+from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.base import MODEL_NAMES
-from shipgym.models.integrate import rk4_row
+from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_row
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
 
 __all__ = [
@@ -238,8 +239,8 @@ class FitResult:
 # replay simulation through the shared kernels
 
 
-@kernel
-def _replay_kernel(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
+@row_kernel
+def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
     nx = x0.shape[0]
     x = np.empty((1, nx))
     for j in range(nx):
@@ -257,6 +258,58 @@ def _replay_kernel(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma:
         rk4_row(model_id, x, u, p, c, h[k], 0, work[0], work[1], work[2], work[3], work[4])
         for j in range(nx):
             out[k + 1, j] = x[0, j]
+
+
+# One compilation of the loop per model: with the model id a compile-time constant the model
+# dispatch of ``rk4_row`` folds away, which makes the replay about three times faster than
+# with the id as a run-time argument (same arithmetic, identical results). Each is compiled
+# on first use.
+@kernel
+def _replay_nomoto1(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
+    _replay_loop(NOMOTO1, x0, delta, dc, speed, n_cmd, h, p, out)
+
+
+@kernel
+def _replay_nomoto2(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
+    _replay_loop(NOMOTO2, x0, delta, dc, speed, n_cmd, h, p, out)
+
+
+@kernel
+def _replay_norrbin(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
+    _replay_loop(NORRBIN, x0, delta, dc, speed, n_cmd, h, p, out)
+
+
+@kernel
+def _replay_bech(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
+    _replay_loop(BECH, x0, delta, dc, speed, n_cmd, h, p, out)
+
+
+_REPLAY_KERNELS = {
+    NOMOTO1: _replay_nomoto1,
+    NOMOTO2: _replay_nomoto2,
+    NORRBIN: _replay_norrbin,
+    BECH: _replay_bech,
+}
+
+
+def _replay_kernel(
+    model_id: int,
+    x0: np.ndarray,
+    delta: np.ndarray,
+    dc: np.ndarray,
+    speed: np.ndarray,
+    n_cmd: np.ndarray,
+    h: np.ndarray,
+    p: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """Replay ``delta`` from ``x0`` with the model ``model_id``, writing the states to ``out``.
+
+    At step ``k`` the rudder and speed states are set to ``delta[k]``, ``speed[k]`` and the
+    commands to ``dc[k]``, ``n_cmd[k]`` (see the module docstring), then one RK4 step of
+    ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_row`.
+    """
+    _REPLAY_KERNELS[model_id](x0, delta, dc, speed, n_cmd, h, p, out)
 
 
 def _replay_inputs(
@@ -817,6 +870,7 @@ def fit_output_error(
     U: npt.ArrayLike | float | None = None,
     x0: npt.ArrayLike | None = None,
     init: Any | None = None,
+    init_delta0: float = 0.0,
     bias: bool = False,
     estimate_psi0: bool = True,
     estimate_r0: bool = True,
@@ -843,6 +897,10 @@ def fit_output_error(
     init : dataclass, optional
         Starting parameters; by default the equation-error estimate (falling back to the
         model's defaults if that fails).
+    init_delta0 : float
+        Starting rudder offset [rad] with ``init`` (``bias`` fits of nomoto1/nomoto2, e.g. a
+        warm start from an earlier :attr:`FitResult.delta0`); without ``init`` the
+        equation-error estimate is used.
     bias : bool
         Also fit a rudder offset (``delta0`` for nomoto1/nomoto2, ``n0``/``b0`` otherwise).
     estimate_psi0, estimate_r0 : bool
@@ -893,7 +951,9 @@ def fit_output_error(
         x_start = np.asarray(x0, dtype=np.float64)
         if x_start.shape != (nx,) or not np.all(np.isfinite(x_start)):
             raise ValueError(f"x0 must be a finite ({nx},) state for {model!r}, got {x0!r}")
-    delta0_start = 0.0
+    if not math.isfinite(init_delta0):
+        raise ValueError(f"init_delta0 must be a finite rudder offset [rad], got {init_delta0!r}")
+    delta0_start = float(init_delta0)
     if init is None:
         init, delta0_start = _start_values(model, t, delta, psi, r, bias, window)
     # free-parameter layout
