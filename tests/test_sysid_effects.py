@@ -38,6 +38,22 @@ def test_clean_record_gets_no_effect(maneuver: str, seed: int) -> None:
     assert abs(res.parameters_after["T"] - 107.3) < 5.0
 
 
+@pytest.mark.parametrize("dt", [0.1, 1.0])
+@pytest.mark.parametrize("maneuver", ["zigzag", "random"])
+def test_clean_record_gets_no_effect_at_other_sampling_rates(maneuver: str, dt: float) -> None:
+    rec = generate_record(None, maneuver=maneuver, dt=dt, duration=DURATION, seed=0)
+    assert identify(rec).effects == []
+
+
+@pytest.mark.parametrize("dt", [0.1, 1.0])
+@pytest.mark.parametrize("effect", ["rudder_offset", "yaw_nonlinearity", "second_order"])
+def test_yaw_effect_named_at_other_sampling_rates(effect: str, dt: float) -> None:
+    rec = generate_record(effect, maneuver="random", dt=dt, duration=DURATION, seed=1)
+    res = identify(rec)
+    assert res.effect_names[:1] == [effect], res.rounds[0]
+    assert res.error_after["psi_rms_deg"] <= 0.5 * res.error_before["psi_rms_deg"]
+
+
 @pytest.mark.parametrize(
     "effect", ["rudder_offset", "yaw_nonlinearity", "rudder_lag", "input_delay", "second_order"]
 )

@@ -143,8 +143,16 @@ CATALOGUE: tuple[str, ...] = NOMOTO_CATALOGUE + tuple(
 BIC_MARGIN = 10.0
 """Required decrease of the held-out BIC ``J`` to accept an effect."""
 
-MIN_RELATIVE_DROP = 0.10
-"""Required relative drop of the held-out heading RMS (yaw effects) or position RMS (current)."""
+MIN_RELATIVE_DROP = 0.20
+"""Required relative drop of the held-out heading RMS (yaw effects) or position RMS (current).
+
+On 84 generated records (7 truths x zigzag/random x dt 0.1/0.5/1 s x 2 seeds) a 10 % guard let
+clean records sampled at 1 s take a spurious ``second_order`` or ``rudder_offset`` (held-out
+drops of 10-16 %: the first-order hold of a 1 s rudder log is itself a small input lag), and
+trailing spurious effects after the right one; 20 % removes them (first effect right in 83 of
+84, the whole list right in 72 of 84, against 79 and 60), while the catalogue effects at their
+default sizes drop the held-out heading error by 50-99 %.
+"""
 
 LAG_EQUIVALENT_T3 = 0.5
 """``second_order`` with ``|T3| < LAG_EQUIVALENT_T3 * T2`` is read as ``rudder_lag``."""

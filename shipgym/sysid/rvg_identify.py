@@ -122,7 +122,7 @@ _MOTION = ("psi", "r", "u", "x", "y")  # the channels of the relative-drop guard
 RVG_MIN_RELATIVE_DROP = 0.3
 """Required drop of the held-out motion RMS (geometric mean) to accept an RVG effect.
 
-Larger than the Nomoto loop's 10 %: each held-out window of the unstable hull starts from a
+Larger than the Nomoto loop's 20 %: each held-out window of the unstable hull starts from a
 noisy measured state, so the held-out score of the right model scatters. On clean generated
 records (seeds 0-4) the largest spurious drop was 20 %; the default-size effects gave 79-94 %.
 """
