@@ -94,3 +94,23 @@ def test_rvg_identification_rejects_records_without_rpm_or_positions() -> None:
     short = _rvg(None)
     with pytest.raises(ValueError, match="window"):
         identify(short, "rvg3dof", window_s=1000.0)
+
+
+@pytest.mark.parametrize(
+    ("effect", "maneuver", "dt"),
+    [
+        (None, "zigzag", 1.0),
+        ("azimuth_offset", "zigzag", 1.0),
+        ("current", "zigzag", 0.25),
+        ("thruster_lift", "random", 1.0),
+        ("sway_offset", "zigzag", 0.5),
+    ],
+)
+def test_rvg_effects_on_other_manoeuvres_and_sampling_rates(
+    effect: str | None, maneuver: str, dt: float
+) -> None:
+    rec = generate_record(effect, base_model="rvg3dof", maneuver=maneuver, seed=1, dt=dt)
+    res = identify(rec, "rvg3dof")
+    assert res.effect_names == ([] if effect is None else [effect])
+    if effect is not None:
+        assert res.error_after["psi_rms_deg"] < 0.5 * res.error_before["psi_rms_deg"]
