@@ -790,6 +790,26 @@ def _start_values(
         except ValueError:
             return None
 
+    def add(params: Any, delta0: float) -> None:
+        """A start built from other fits, scored by its free-run error like the direct one."""
+        cand = FitResult(
+            model,
+            params,
+            {},
+            {},
+            np.zeros((0, 0)),
+            (),
+            _initial_state(model, t, r, psi, window, 3),
+            math.nan,
+            math.nan,
+            math.nan,
+            "equation_error",
+            t.shape[0],
+            delta0,
+        )
+        _evaluate(cand, t, delta, psi, r, np.ones_like(t))
+        candidates.append(cand)
+
     direct = attempt(model)
     if direct is not None:
         candidates.append(direct)
@@ -807,23 +827,7 @@ def _start_values(
                 params = BechParams(
                     K, T1, T2, T3, v["n0"] / K, v["n1"] / K, v["n2"] / K, v["n3"] / K
                 )
-            cand = FitResult(
-                model,
-                params,
-                {},
-                {},
-                np.zeros((0, 0)),
-                (),
-                _initial_state(model, t, r, psi, window, 3),
-                math.nan,
-                math.nan,
-                math.nan,
-                "equation_error",
-                t.shape[0],
-                first.delta0,
-            )
-            _evaluate(cand, t, delta, psi, r, np.ones_like(t))
-            candidates.append(cand)
+            add(params, first.delta0)
     if model in ("norrbin", "bech"):
         # the linear model with the nonlinear terms off: a stable start, where the direct
         # regression may land on the wrong sign of n1 (an unstable-ship branch)
@@ -834,23 +838,7 @@ def _start_values(
                 params = NorrbinParams(v["K"], v["T"], 0.0, 1.0, 0.0, 0.0)
             else:
                 params = BechParams(v["K"], v["T1"], v["T2"], v["T3"], 0.0, 1.0 / v["K"], 0.0, 0.0)
-            cand = FitResult(
-                model,
-                params,
-                {},
-                {},
-                np.zeros((0, 0)),
-                (),
-                _initial_state(model, t, r, psi, window, 3),
-                math.nan,
-                math.nan,
-                math.nan,
-                "equation_error",
-                t.shape[0],
-                lin_fit.delta0,
-            )
-            _evaluate(cand, t, delta, psi, r, np.ones_like(t))
-            candidates.append(cand)
+            add(params, lin_fit.delta0)
     if not candidates:
         return _PARAM_CLASS[model](), 0.0
     best = min(candidates, key=lambda c: c.rms_r if math.isfinite(c.rms_r) else math.inf)
