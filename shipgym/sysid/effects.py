@@ -88,14 +88,14 @@ import math
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
-from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
+from shipgym.models import Nomoto1Params, SteeringGear, make_model
 from shipgym.models._jit import kernel
 from shipgym.models.integrate import NOMOTO1, rk4_row
 from shipgym.models.nomoto import IDELTA
@@ -395,38 +395,7 @@ def _fit_config(
                     init_delta0=warm.delta0,
                     **kw,
                 )
-            if cfg.nonlinear:
-                # start the nonlinear model from the linear fit with its terms off: the
-                # equation-error start of a polynomial yaw model is fragile on short segments
-                lin = fit_with_model(_Config(**{**cfg.__dict__, "nonlinear": False}), seg, kw)
-                v = lin.values
-                if cfg.second:
-                    init: Any = BechParams(
-                        v["K"], v["T1"], v["T2"], v["T3"], 0.0, 1.0 / v["K"], 0.0, 0.0
-                    )
-                else:
-                    init = NorrbinParams(v["K"], v["T"], 0.0, 1.0, 0.0, 0.0)
-                if cfg.bias:  # rudder offset delta0 <-> n0 = -K delta0, b0 = n0 / K
-                    if cfg.second:
-                        init = replace(init, b0=-lin.delta0)
-                    else:
-                        init = replace(init, n0=-lin.delta0 * v["K"])
-                return fit_output_error(*seg, cfg.model, bias=cfg.bias, init=init, **kw)
-            return fit_with_model(cfg, seg, kw)
-
-    def fit_with_model(c: _Config, seg: tuple[np.ndarray, ...], kw: dict[str, Any]) -> FitResult:
-        with warnings.catch_warnings(), np.errstate(all="ignore"):
-            warnings.simplefilter("ignore", SysidWarning)
-            warnings.simplefilter("ignore", RuntimeWarning)
-            try:
-                return fit_output_error(*seg, c.model, bias=c.bias, **kw)
-            except TypeError:
-                # the equation-error start of fit.py fails for nomoto2 with a bias
-                # (Nomoto2Params gets a delta0 keyword): start from the fit without bias
-                if not c.bias:
-                    raise
-                start = fit_output_error(*seg, c.model, bias=False, **kw)
-                return fit_output_error(*seg, c.model, bias=True, init=start.params, **kw)
+            return fit_output_error(*seg, cfg.model, bias=cfg.bias, **kw)
 
     search_kw = {"sigma": sigma, "reweight": False, "max_nfev": _SEARCH_NFEV}
 
@@ -623,9 +592,13 @@ def resolve_window(window_s: float | str | None, duration: float, base: str) -> 
 
 
 def _errors(
-    t: np.ndarray, rec: Record, sim: dict[str, np.ndarray], sl: slice = slice(None)
+    rec: Record, sim: dict[str, np.ndarray], sl: slice | np.ndarray = slice(None)
 ) -> dict[str, float]:
-    """RMS errors of simulated channels against the record over the samples ``sl``."""
+    """RMS errors of simulated channels against the record over the samples ``sl``.
+
+    ``sim`` maps channel names (``psi``, ``r`` and optionally ``x``, ``y``, ``u``) to
+    simulated series; shared by the Nomoto-family and the RVG reports.
+    """
     e_psi = _wrap(sim["psi"][sl] - rec.psi[sl])
     out = {
         "psi_rms_deg": math.degrees(float(np.sqrt(np.mean(e_psi**2)))),
@@ -1229,8 +1202,8 @@ def identify(
         diagnostics=diagnostics,
         parameters_before=params_before,
         parameters_after=params_after,
-        error_before=_errors(t, record, sim_before),
-        error_after=_errors(t, record, sim_after),
+        error_before=_errors(record, sim_before),
+        error_after=_errors(record, sim_after),
         window_s=window,
         heldout=heldout,
         traces=_traces(record, split, starts, sim_before, sim_after),

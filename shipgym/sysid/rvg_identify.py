@@ -334,11 +334,10 @@ def _residuals(
     sim: np.ndarray, meas: np.ndarray, mask: np.ndarray, sigma: tuple[float, ...]
 ) -> np.ndarray:
     """Weighted residuals of the channels over the samples in ``mask``."""
-    cols = (2, 5, 3, 4, 0, 1)  # psi, r, u, v, x, y in the state / measured layouts
-    mcols = (2, 5, 3, 4, 0, 1)
     parts = []
-    for ch, (c, mc) in enumerate(zip(cols, mcols, strict=True)):
-        e = sim[mask, c] - meas[mask, mc]
+    # psi, r, u, v, x, y: the same columns in the state and the measured layouts
+    for ch, c in enumerate((2, 5, 3, 4, 0, 1)):
+        e = sim[mask, c] - meas[mask, c]
         if ch == 0:
             e = (e + np.pi) % (2.0 * np.pi) - np.pi
         parts.append(e / sigma[ch])
@@ -450,16 +449,19 @@ def _score(fit: RVGFit, record: Record, starts: np.ndarray, mask: np.ndarray, ha
     return {"J": J, "rss": rss, "n": n}
 
 
-def _errors(sim: np.ndarray, record: Record, sl: slice | np.ndarray) -> dict[str, float]:
-    meas = _measured(record)
-    e_psi = (sim[sl, 2] - meas[sl, 2] + np.pi) % (2.0 * np.pi) - np.pi
-    d2 = (sim[sl, 0] - meas[sl, 0]) ** 2 + (sim[sl, 1] - meas[sl, 1]) ** 2
-    return {
-        "psi_rms_deg": math.degrees(float(np.sqrt(np.mean(e_psi**2)))),
-        "r_rms_deg_s": math.degrees(float(np.sqrt(np.mean((sim[sl, 5] - meas[sl, 5]) ** 2)))),
-        "xy_rms_m": float(np.sqrt(np.mean(d2))),
-        "u_rms_m_s": float(np.sqrt(np.mean((sim[sl, 3] - meas[sl, 3]) ** 2))),
-    }
+_REPORTED = (("psi", 2), ("r", 5), ("x", 0), ("y", 1), ("u", 3))  # channel, state column
+
+
+def _channels(sim: np.ndarray) -> dict[str, np.ndarray]:
+    """The reported channels of an ``(n, 10)`` RVG simulation."""
+    return {ch: sim[:, col] for ch, col in _REPORTED}
+
+
+def _errors(sim: np.ndarray, record: Record, idx: np.ndarray) -> dict[str, float]:
+    """:func:`shipgym.sysid.effects._errors` of an RVG simulation over the samples ``idx``."""
+    from shipgym.sysid.effects import _errors as errors
+
+    return errors(record, _channels(sim), idx)
 
 
 def _effect_parameters(fit: RVGFit, name: str) -> dict[str, float]:
@@ -627,7 +629,7 @@ def identify_rvg(
         },
     }
     traces: dict[str, Any] = {"time": t, "split": split, "window_starts": starts}
-    for ch, col in (("psi", 2), ("r", 5), ("x", 0), ("y", 1), ("u", 3)):
+    for ch, col in _REPORTED:
         traces[ch] = {
             "measured": getattr(record, ch),
             "before": sim_before[:, col],
