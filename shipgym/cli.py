@@ -7,15 +7,17 @@ Subcommands::
                   [--plot OUT.png]
     shipgym envs
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
-    shipgym evaluate --env ID [--controller classic|zero] [--episodes N] [--seed S]
-                     [--json OUT] [--plot DIR]
+    shipgym evaluate --env ID [--controller classic|ppo|sac|zero] [--episodes N] [--seed S]
+                     [--agents DIR] [--json OUT] [--plot DIR]
+    shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
+    shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
+                      [--env ID]... [--controller NAME]... [--no-stress] [--no-throughput]
     shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
 
 Each subcommand is registered by a builder in ``SUBCOMMANDS`` (name -> function that adds its
-parser and sets ``handler``), so later subcommands (train, benchmark) plug in with
-one entry. Bad input ends with a one-line message and exit code 2
+parser and sets ``handler``). Bad input ends with a one-line message and exit code 2
 (argparse's own message for bad arguments, ``shipgym: error: ...`` for a ``ValueError`` raised
 by the library), never a traceback. Heavy imports happen inside the handlers, so
 ``shipgym --help`` is fast.
@@ -467,7 +469,15 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     from shipgym.benchmark import evaluate, make_policy
     from shipgym.benchmark.plots import plot_result
 
-    policy = make_policy(args.controller, args.env)
+    json_path = _output_path(args.json, "--json", ".json")
+    policy = make_policy(args.controller, args.env, args.agents)
+    if hasattr(policy, "meta"):
+        from shipgym.benchmark.runner import check_seeds_disjoint
+
+        try:
+            check_seeds_disjoint(policy.meta, args.seed, args.episodes)
+        except ValueError as exc:
+            print(f"{PROG}: warning: {exc}", file=sys.stderr)
     result = evaluate(
         args.env,
         policy,
@@ -485,10 +495,11 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     print(f"  return {summary['mean_return']:.2f} +- {summary['std_return']:.2f}")
     for key, value in summary["metrics"].items():
         print(f"  {key:22s} {value:10.3f} +- {summary['metrics_std'][key]:.3f}")
-    if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(summary, fh, indent=2)
-        print(f"wrote {args.json}")
+    if json_path is not None:
+        _write_atomically(
+            [(json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n"))]
+        )
+        print(f"wrote {json_path}")
     if args.plot:
         for path in plot_result(result, args.plot, max_episodes=args.episodes):
             print(f"wrote {path}")
@@ -503,15 +514,22 @@ def _build_evaluate(sub: Any) -> None:
         "evaluate",
         help="run a controller on an env over seeded episodes and report the task metrics",
         description=(
-            "Run the classic controller (or the zero baseline) of an env for N episodes with "
-            "seeds S, S+1, ... (identical initial states, setpoints, paths, targets and "
-            "currents for every controller) and print the mean return and the task metrics."
+            "Run the classic controller, a trained PPO or SAC agent or the zero command on an "
+            "env for N episodes with seeds S, S+1, ... (identical initial states, setpoints, "
+            "paths, targets and currents for every controller) and print the mean return and "
+            "the task metrics."
         ),
     )
     p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
     p.add_argument("--controller", default="classic", choices=POLICIES, help="%(default)s")
     p.add_argument("--episodes", type=_positive_int, default=10, metavar="N")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="first seed (%(default)s)")
+    p.add_argument(
+        "--agents",
+        default=None,
+        metavar="DIR",
+        help="folder of the ppo/sac agents (default: the agents shipped with shipgym)",
+    )
     p.add_argument(
         "--max-current-speed",
         type=_finite_float,
@@ -524,6 +542,234 @@ def _build_evaluate(sub: Any) -> None:
         "--plot", default=None, metavar="DIR", help="write a figure per episode into DIR"
     )
     p.set_defaults(handler=_run_evaluate)
+
+
+# ------------------------------------------------------------------------------------------
+# train
+# ------------------------------------------------------------------------------------------
+def _run_train(args: argparse.Namespace) -> int:
+    from shipgym.rl.train import config, train
+
+    cfg = config(args.env, args.algo)
+    timesteps = args.timesteps or cfg["timesteps"]
+    bar = not args.quiet and sys.stderr.isatty()
+    print(
+        f"training {args.algo} on {args.env}: {timesteps} steps, seed {args.seed}, "
+        f"{args.num_envs or cfg['num_envs']} sub-envs, into {args.out}",
+        flush=True,
+    )
+    result = train(
+        args.env,
+        args.algo,
+        timesteps=timesteps,
+        seed=args.seed,
+        out_dir=args.out,
+        num_envs=args.num_envs,
+        eval_freq=args.eval_freq,
+        eval_episodes=args.eval_episodes,
+        progress_bar=bar,
+        progress=None if (bar or args.quiet) else _progress,
+    )
+    meta = result.meta
+    print(
+        f"{meta['name']}: {meta['timesteps']} steps in {meta['wall_time_s']:.0f} s "
+        f"({meta['steps_per_s']:.0f} steps/s); best validation return "
+        f"{meta['best_validation_return']:.1f} at step {meta['best_timestep']}"
+    )
+    print(f"wrote {result.model_path} and {result.meta_path}")
+    return 0
+
+
+def _build_train(sub: Any) -> None:
+    from shipgym.envs import ENV_IDS
+    from shipgym.rl.train import ALGOS
+
+    p = sub.add_parser(
+        "train",
+        help="train a PPO or SAC agent (stable-baselines3) on an env",
+        description=(
+            "Train a stable-baselines3 agent on the NumPy-batched vector env (one kernel call "
+            "steps every sub-env), with observation normalisation and an evaluation callback "
+            "on fixed validation seeds that keeps the best policy. Writes DIR/<name>.zip and "
+            "DIR/<name>.json (budget, seeds, wall time, learning curve, normaliser). Needs "
+            "the rl extra: pip install 'shipgym[rl]'."
+        ),
+    )
+    p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
+    p.add_argument("--algo", required=True, choices=ALGOS, help="algorithm")
+    p.add_argument(
+        "--timesteps",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="environment steps (default: the shipped agent's budget)",
+    )
+    p.add_argument(
+        "--seed",
+        type=_nonnegative_int,
+        default=0,
+        metavar="S",
+        help="seed of the networks; training sub-env i gets S + i (%(default)s)",
+    )
+    p.add_argument("--out", default="shipgym-agents", metavar="DIR", help="%(default)s")
+    p.add_argument(
+        "--num-envs",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="training sub-envs (default: 16 for PPO, 8 for SAC)",
+    )
+    p.add_argument(
+        "--eval-freq",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="env steps between evaluations (default: 1/20 of the budget)",
+    )
+    p.add_argument(
+        "--eval-episodes",
+        type=_positive_int,
+        default=16,
+        metavar="N",
+        help="validation episodes per evaluation (%(default)s)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(handler=_run_train)
+
+
+# ------------------------------------------------------------------------------------------
+# benchmark
+# ------------------------------------------------------------------------------------------
+def _run_benchmark(args: argparse.Namespace) -> int:
+    import json
+
+    from shipgym.benchmark.plots import (
+        plot_benchmark_metrics,
+        plot_benchmark_trajectories,
+        plot_throughput,
+    )
+    from shipgym.benchmark.runner import CONDITIONS, run_benchmark
+    from shipgym.benchmark.throughput import ppo_throughput, throughput_table
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out names a file, expected a directory: {args.out!r}")
+    out.mkdir(parents=True, exist_ok=True)
+    json_path = _output_path(args.json or str(out / "benchmark.json"), "--json", ".json")
+    csv_path = _output_path(args.csv or str(out / "benchmark.csv"), "--csv", ".csv")
+    plots = Path(args.plots) if args.plots else out
+    if plots.exists() and not plots.is_dir():
+        raise ValueError(f"--plots names a file, expected a directory: {args.plots!r}")
+    envs = args.env or None
+    controllers = args.controller or None
+    progress = (lambda line: None) if args.quiet else _progress
+    kwargs: dict[str, Any] = {}
+    if envs:
+        kwargs["envs"] = envs
+    if controllers:
+        kwargs["controllers"] = controllers
+    result = run_benchmark(
+        episodes=args.episodes,
+        seed=args.seed,
+        conditions=CONDITIONS if not args.no_stress else ("nominal",),
+        agents_dir=args.agents,
+        progress=progress,
+        **kwargs,
+    )
+    print(result.table())
+    print(f"({result.runtime_s:.0f} s)")
+    assert json_path is not None and csv_path is not None
+    _write_atomically(
+        [
+            (json_path, lambda p: result.write_json(p)),
+            (csv_path, lambda p: result.write_csv(p)),
+        ]
+    )
+    print(f"wrote {json_path} and {csv_path}")
+    plots.mkdir(parents=True, exist_ok=True)
+    print(f"wrote {plot_benchmark_metrics(result, plots / 'metrics.png')}")
+    for env_id in result.envs:
+        name = env_id.split("/")[-1]
+        print(f"wrote {plot_benchmark_trajectories(result, env_id, plots / f'{name}.png')}")
+    if not args.no_throughput:
+        rows = ppo_throughput(result.envs, timesteps=args.throughput_steps, progress=progress)
+        print(throughput_table(rows))
+        path = out / "throughput.json"
+        _write_atomically([(path, lambda p: p.write_text(json.dumps(rows, indent=2) + "\n"))])
+        print(f"wrote {path}")
+        print(f"wrote {plot_throughput(rows, plots / 'throughput.png')}")
+    return 0
+
+
+def _build_benchmark(sub: Any) -> None:
+    from shipgym.benchmark.runner import CONTROLLERS
+    from shipgym.envs import ENV_IDS
+    from shipgym.rl.train import BENCHMARK_SEED
+
+    p = sub.add_parser(
+        "benchmark",
+        help="classic controllers vs the trained PPO/SAC agents vs zero on every env",
+        description=(
+            "Evaluate the classic controller, the shipped PPO and SAC agents and the zero "
+            "command on every env with identical seeds and current draws (seeds disjoint from "
+            "the agents' training and validation seeds), under the nominal currents and at "
+            "1.5 x the training maximum (stress). Prints a table of mean +- std of each metric, "
+            "writes JSON (a list of 'shipgym evaluate' objects) and CSV, figures of metrics "
+            "and trajectories, and PPO's training throughput on each env against CartPole-v1."
+        ),
+    )
+    p.add_argument(
+        "--episodes",
+        type=_positive_int,
+        default=20,
+        metavar="N",
+        help="episodes per env, controller and condition (%(default)s)",
+    )
+    p.add_argument(
+        "--seed",
+        type=_nonnegative_int,
+        default=BENCHMARK_SEED,
+        metavar="S",
+        help="first seed (%(default)s)",
+    )
+    p.add_argument("--out", default="shipgym-benchmark", metavar="DIR", help="%(default)s")
+    p.add_argument("--json", default=None, metavar="OUT", help="default: DIR/benchmark.json")
+    p.add_argument("--csv", default=None, metavar="OUT", help="default: DIR/benchmark.csv")
+    p.add_argument("--plots", default=None, metavar="DIR", help="figures (default: --out)")
+    p.add_argument(
+        "--env",
+        action="append",
+        choices=ENV_IDS,
+        default=None,
+        metavar="ID",
+        help="only this env (repeatable; default: all)",
+    )
+    p.add_argument(
+        "--controller",
+        action="append",
+        choices=CONTROLLERS,
+        default=None,
+        help="only this controller (repeatable; default: all)",
+    )
+    p.add_argument(
+        "--agents",
+        default=None,
+        metavar="DIR",
+        help="folder of the ppo/sac agents (default: the shipped ones)",
+    )
+    p.add_argument("--no-stress", action="store_true", help="skip the stress condition")
+    p.add_argument(
+        "--no-throughput", action="store_true", help="skip the PPO throughput measurement"
+    )
+    p.add_argument(
+        "--throughput-steps",
+        type=_positive_int,
+        default=16_384,
+        metavar="N",
+        help="timed PPO steps per env and run (%(default)s)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(handler=_run_benchmark)
 
 
 # ------------------------------------------------------------------------------------------
@@ -947,13 +1193,15 @@ def _build_identify(sub: Any) -> None:
     p.set_defaults(handler=_run_identify)
 
 
-#: Subcommand name -> builder. Planned: train, benchmark.
+#: Subcommand name -> builder.
 SUBCOMMANDS: dict[str, Builder] = {
     "demo": _build_demo,
     "bench": _build_bench,
     "envs": _build_envs,
     "simulate": _build_simulate,
     "evaluate": _build_evaluate,
+    "train": _build_train,
+    "benchmark": _build_benchmark,
     "identify": _build_identify,
 }
 
@@ -994,7 +1242,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValueError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
-    except OSError as exc:
+    except (OSError, ImportError) as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:

@@ -72,6 +72,7 @@ class EvaluationResult:
     per_episode: list[dict[str, float]]
     logs: list[EpisodeLog] = field(repr=False)
     options: dict[str, Any] = field(default_factory=dict)
+    condition: str = "nominal"
 
     @property
     def metrics(self) -> dict[str, float]:
@@ -86,10 +87,11 @@ class EvaluationResult:
         return {k: float(np.std([m[k] for m in self.per_episode])) for k in keys}
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object: env, controller, episodes, mean/std return and metric means."""
+        """The JSON object: env, controller, condition, episodes, mean/std return, metrics."""
         return {
             "env": self.env,
             "controller": self.controller,
+            "condition": self.condition,
             "episodes": self.episodes,
             "seed": self.seed,
             "mean_return": float(np.mean(self.returns)),
@@ -157,6 +159,36 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
     raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
 
 
+def _start(
+    env: gym.Env, seed: int, options: dict[str, Any] | None
+) -> tuple[EpisodeLog, np.ndarray, dict[str, Any]]:
+    """Reset ``env`` with ``seed``; the episode's log, first observation and reset info."""
+    log = EpisodeLog(seed=seed)
+    obs, info = env.reset(seed=seed, options=options)
+    log.reset_info = info
+    task = env.unwrapped.task
+    if hasattr(task, "waypoints"):
+        log.extras["waypoints"] = task.waypoints(0)
+    return log, obs, info
+
+
+def _record_step(
+    env: gym.Env, log: EpisodeLog, action: np.ndarray, targets: list[np.ndarray], dt: float
+) -> tuple[np.ndarray, bool]:
+    """Step ``env`` with ``action`` and log the step; the observation and whether it ended."""
+    action = np.asarray(action, dtype=np.float32)
+    obs, reward, terminated, truncated, info = env.step(action)
+    log.time.append(len(log.time) * dt + dt)
+    log.state.append(info["state"])
+    log.action.append(np.clip(action, -1.0, 1.0))
+    log.reward.append(float(reward))
+    log.info.append(info)
+    task = env.unwrapped.task
+    if hasattr(task, "target"):
+        targets.append(task.target[0].copy())
+    return obs, bool(terminated or truncated)
+
+
 def evaluate(
     env_id: str,
     policy: Any,
@@ -166,6 +198,7 @@ def evaluate(
     env_kwargs: dict[str, Any] | None = None,
     reset_options: dict[str, Any] | None = None,
     progress: Callable[[str], None] | None = None,
+    condition: str = "nominal",
 ) -> EvaluationResult:
     """Run ``policy`` for ``episodes`` episodes with seeds ``seed``, ``seed + 1``, ...
 
@@ -174,7 +207,10 @@ def evaluate(
     env_id : str
         One of :data:`shipgym.envs.ENV_IDS`.
     policy : object
-        Has ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (normalised).
+        Has ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (normalised). A
+        memoryless policy that also has ``act_batch(obs) -> actions`` (a batch of
+        observations, one row per episode) runs all episodes in lockstep, one call per step;
+        the episodes and results are the same.
     controller : str
         Name recorded in the result.
     episodes, seed : int
@@ -185,6 +221,9 @@ def evaluate(
         Options passed to every ``reset``.
     progress : callable, optional
         Called with a short line after each episode (default: print to stderr).
+    condition : str
+        Name of the scenario set, recorded in the result (the benchmark's ``nominal`` or
+        ``stress``).
 
     Returns
     -------
@@ -199,44 +238,61 @@ def evaluate(
         def progress(line: str) -> None:
             print(line, file=sys.stderr, flush=True)
 
-    env = gym.make(env_id, **(env_kwargs or {}))
-    dt = env.unwrapped.dt
+    batched = hasattr(policy, "act_batch")
+    n_envs = episodes if batched else 1
+    envs = [gym.make(env_id, **(env_kwargs or {})) for _ in range(n_envs)]
+    dt = envs[0].unwrapped.dt
     logs: list[EpisodeLog] = []
     per_episode: list[dict[str, float]] = []
-    for k in range(episodes):
-        log = EpisodeLog(seed=seed + k)
-        obs, info = env.reset(seed=seed + k, options=reset_options)
-        log.reset_info = info
-        task = env.unwrapped.task
-        if hasattr(task, "waypoints"):
-            log.extras["waypoints"] = task.waypoints(0)
-        targets: list[np.ndarray] = []
-        policy.reset(env.unwrapped, obs, info)
-        t = 0.0
-        done = False
-        while not done:
-            action = np.asarray(policy.act(obs, info), dtype=np.float32)
-            obs, reward, terminated, truncated, info = env.step(action)
-            t += dt
-            log.time.append(t)
-            log.state.append(info["state"])
-            log.action.append(np.clip(action, -1.0, 1.0))
-            log.reward.append(float(reward))
-            log.info.append(info)
-            if hasattr(task, "target"):
-                targets.append(task.target[0].copy())
-            done = terminated or truncated
+
+    def finish(log: EpisodeLog, targets: list[np.ndarray]) -> None:
         if targets:
             log.extras["target"] = np.asarray(targets)
         metrics = episode_metrics(env_id, log, dt)
         logs.append(log)
         per_episode.append(metrics)
         progress(
-            f"{env_id} {controller} episode {k + 1}/{episodes} (seed {seed + k}): "
+            f"{env_id} {controller} episode {len(logs)}/{episodes} (seed {log.seed}): "
             f"return {log.episode_return:.1f}, "
             + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
         )
-    env.close()
+
+    if batched:
+        # memoryless policy: every episode at once, one policy call per step for all ships
+        starts = [_start(env, seed + k, reset_options) for k, env in enumerate(envs)]
+        ep_logs = [log for log, _, _ in starts]
+        obs = np.stack([o for _, o, _ in starts])
+        targets: list[list[np.ndarray]] = [[] for _ in envs]
+        active = list(range(episodes))
+        for k, (_, o, info) in enumerate(starts):
+            policy.reset(envs[k].unwrapped, o, info)
+        while active:
+            actions = np.asarray(policy.act_batch(obs[active]), dtype=np.float32)
+            still = []
+            for j, k in enumerate(active):
+                o, done = _record_step(envs[k], ep_logs[k], actions[j], targets[k], dt)
+                obs[k] = o
+                if done:
+                    finish(ep_logs[k], targets[k])
+                else:
+                    still.append(k)
+            active = still
+        order = np.argsort([log.seed for log in logs])
+        logs[:] = [logs[i] for i in order]
+        per_episode[:] = [per_episode[i] for i in order]
+    else:
+        env = envs[0]
+        for k in range(episodes):
+            log, obs_k, info = _start(env, seed + k, reset_options)
+            policy.reset(env.unwrapped, obs_k, info)
+            targets_k: list[np.ndarray] = []
+            done = False
+            while not done:
+                action = np.asarray(policy.act(obs_k, log.info[-1] if log.info else info))
+                obs_k, done = _record_step(env, log, action, targets_k, dt)
+            finish(log, targets_k)
+    for env in envs:
+        env.close()
     return EvaluationResult(
         env=env_id,
         controller=controller,
@@ -246,4 +302,5 @@ def evaluate(
         per_episode=per_episode,
         logs=logs,
         options=dict(reset_options or {}),
+        condition=condition,
     )

@@ -93,3 +93,171 @@ def plot_result(result: EvaluationResult, out_dir: str | Path, max_episodes: int
         plot_episode(result, log, Path(out_dir) / f"{name}_{result.controller}_seed{log.seed}.png")
         for log in result.logs[:max_episodes]
     ]
+
+
+# ------------------------------------------------------------------------------------------
+# benchmark figures
+# ------------------------------------------------------------------------------------------
+#: One colour per controller, the same in every benchmark figure.
+CONTROLLER_COLOURS = {
+    "classic": "#1f5fa8",
+    "ppo": "#c0392b",
+    "sac": "#2e8b57",
+    "zero": "#9a9a9a",
+}
+
+
+def _colour(name: str) -> str:
+    return CONTROLLER_COLOURS.get(name, "#8e44ad")
+
+
+def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
+    """Bars of every metric (and the return), one row per env: mean and std over episodes.
+
+    Each controller has its colour; the nominal condition is plain, the stress condition
+    hatched beside it.
+    """
+    from shipgym.benchmark.evaluate import METRICS
+
+    envs, controllers, conditions = benchmark.envs, benchmark.controllers, benchmark.conditions
+    ncols = 1 + max(len(METRICS[e]) for e in envs)
+    fig = Figure(figsize=(3.4 * ncols, 2.6 * len(envs)), constrained_layout=True)
+    FigureCanvasAgg(fig)
+    axes = np.atleast_2d(fig.subplots(len(envs), ncols, squeeze=False))
+    width = 0.8 / len(conditions)
+    for i, env_id in enumerate(envs):
+        keys = ("return", *METRICS[env_id])
+        for j in range(ncols):
+            ax = axes[i, j]
+            if j >= len(keys):
+                ax.axis("off")
+                continue
+            key = keys[j]
+            for c, cond in enumerate(conditions):
+                means, stds = [], []
+                for name in controllers:
+                    d = benchmark.get(env_id, name, cond).to_dict()
+                    if key == "return":
+                        means.append(d["mean_return"])
+                        stds.append(d["std_return"])
+                    else:
+                        means.append(d["metrics"][key])
+                        stds.append(d["metrics_std"][key])
+                x = np.arange(len(controllers)) + (c - (len(conditions) - 1) / 2) * width
+                ax.bar(
+                    x,
+                    means,
+                    width,
+                    yerr=stds,
+                    capsize=2,
+                    color=[_colour(n) for n in controllers],
+                    hatch="//" if cond == "stress" else None,
+                    edgecolor="k" if cond == "stress" else "none",
+                    alpha=0.6 if cond == "stress" else 1.0,
+                    label=cond,
+                )
+            ax.set_xticks(np.arange(len(controllers)), controllers, fontsize=8)
+            ax.set_title(
+                f"{env_id.split('/')[-1]}: {key}" if j == 0 else key,
+                fontsize=9,
+            )
+            ax.grid(axis="y", alpha=0.3)
+            if i == 0 and j == 0 and len(conditions) > 1:
+                ax.legend(fontsize=7, title="hatched = stress", title_fontsize=7)
+    fig.suptitle(
+        f"benchmark: {benchmark.episodes} episodes from seed {benchmark.seed} per bar "
+        f"(mean, std); return: higher is better, errors: lower is better",
+        fontsize=11,
+    )
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    return path
+
+
+def plot_benchmark_trajectories(benchmark: Any, env_id: str, path: str | Path) -> Path:
+    """The first episode of every controller on ``env_id``: track and key signal.
+
+    One row per condition; left the tracks (with the path or the target), right the task's
+    error signal over time. All controllers start from the same seeded scenario.
+    """
+    conditions, controllers = benchmark.conditions, benchmark.controllers
+    key, label, scale = _SIGNAL[env_id]
+    fig = Figure(figsize=(13, 4.8 * len(conditions)), constrained_layout=True)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(conditions), 2, squeeze=False, width_ratios=(1.0, 1.3))
+    for i, cond in enumerate(conditions):
+        ax_track, ax_sig = axes[i]
+        first = None
+        for name in controllers:
+            result = benchmark.get(env_id, name, cond)
+            log = result.logs[0]
+            first = first or log
+            state = np.asarray(log.state)
+            x0 = log.reset_info["state"]
+            north = np.concatenate(([x0[0]], state[:, 0]))
+            east = np.concatenate(([x0[1]], state[:, 1]))
+            ax_track.plot(east, north, color=_colour(name), lw=1.5, label=name)
+            ax_sig.plot(
+                log.time,
+                log.signal(key) * scale,
+                color=_colour(name),
+                lw=1.2,
+                label=f"{name}: return {log.episode_return:.0f}",
+            )
+        assert first is not None
+        ax_track.plot(
+            first.reset_info["state"][1], first.reset_info["state"][0], "ko", ms=5, label="start"
+        )
+        if "waypoints" in first.extras:
+            wp = np.asarray(first.extras["waypoints"])
+            ax_track.plot(wp[:, 1], wp[:, 0], "--s", color="0.4", ms=4, lw=1, label="path")
+        if "target" in first.extras:
+            tgt = np.asarray(first.extras["target"])
+            ax_track.plot(tgt[:, 1], tgt[:, 0], color="#e67e22", lw=1.5, ls=":", label="target")
+        speed = first.reset_info["current_speed"]
+        direction = math.degrees(first.reset_info["current_direction"]) % 360
+        ax_track.set_title(
+            f"{cond}: seed {first.seed}, current {speed:.2f} m/s toward {direction:.0f} deg",
+            fontsize=10,
+        )
+        ax_track.set_xlabel("east [m]")
+        ax_track.set_ylabel("north [m]")
+        ax_track.set_aspect("equal", adjustable="datalim")
+        ax_track.grid(alpha=0.3)
+        ax_track.legend(fontsize=8)
+        ax_sig.axhline(0.0, color="k", lw=0.8)
+        ax_sig.set_xlabel("time [s]")
+        ax_sig.set_ylabel(label)
+        ax_sig.grid(alpha=0.3)
+        ax_sig.legend(fontsize=8)
+    fig.suptitle(f"{env_id}: the same scenario for every controller", fontsize=12)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    return path
+
+
+def plot_throughput(rows: list[dict[str, Any]], path: str | Path) -> Path:
+    """Bars of PPO training steps/s relative to CartPole-v1, with the target line."""
+    fig = Figure(figsize=(9, 3.8), constrained_layout=True)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    names = [r["env"].split("/")[-1] for r in rows]
+    ratios = [r["ratio"] for r in rows]
+    colours = ["0.6" if r["met"] is None else ("#2e8b57" if r["met"] else "#c0392b") for r in rows]
+    ax.bar(names, ratios, color=colours)
+    for k, r in enumerate(rows):
+        ax.text(k, r["ratio"], f"{r['steps_per_s']:.0f}/s", ha="center", va="bottom", fontsize=8)
+    targets = [r["target"] for r in rows if r["target"] is not None]
+    if targets:
+        ax.axhline(targets[0], color="k", ls="--", lw=1, label=f"target {targets[0]:g}")
+        ax.legend(fontsize=8)
+    ax.set_ylabel("PPO env steps/s relative to CartPole-v1")
+    ax.tick_params(axis="x", labelsize=8)
+    ax.grid(axis="y", alpha=0.3)
+    ax.set_title("training throughput: same PPO settings, one process", fontsize=10)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    return path

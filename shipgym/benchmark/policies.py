@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from functools import cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -121,6 +122,9 @@ class ZeroPolicy:
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         return np.zeros(self.act_dim, dtype=np.float32)
+
+    def act_batch(self, obs: np.ndarray) -> np.ndarray:
+        return np.zeros((len(obs), self.act_dim), dtype=np.float32)
 
 
 class NomotoHeadingClassic:
@@ -274,16 +278,24 @@ _CLASSIC = {
     "shipgym/RVGTargetTracking-v0": RVGTargetClassic,
 }
 
-#: Names accepted by ``shipgym evaluate --controller``.
-POLICIES = ("classic", "zero")
+#: Names accepted by ``shipgym evaluate --controller``: the classic controller, the trained
+#: PPO and SAC agents (:mod:`shipgym.rl.agents`) and the neutral command.
+POLICIES = ("classic", "ppo", "sac", "zero")
 
 
-def make_policy(name: str, env_id: str) -> Any:
-    """The policy ``name`` (``"classic"`` or ``"zero"``) for ``env_id``."""
+def make_policy(name: str, env_id: str, agents_dir: str | Path | None = None) -> Any:
+    """The policy ``name`` (one of :data:`POLICIES`) for ``env_id``.
+
+    ``ppo`` and ``sac`` load the shipped agents, or those in ``agents_dir``.
+    """
+    if env_id not in _CLASSIC:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {tuple(_CLASSIC)}")
     if name == "zero":
         return ZeroPolicy()
     if name == "classic":
-        if env_id not in _CLASSIC:
-            raise ValueError(f"unknown env {env_id!r}; expected one of {tuple(_CLASSIC)}")
         return _CLASSIC[env_id]()
+    if name in ("ppo", "sac"):
+        from shipgym.rl.agents import load_agent
+
+        return load_agent(env_id, name, agents_dir)
     raise ValueError(f"unknown controller {name!r}; expected one of {POLICIES}")

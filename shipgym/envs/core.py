@@ -6,6 +6,12 @@ autoreset (as Gymnasium's ``CartPoleVectorEnv``). Both step through the same tas
 the physics exists once. Sub-env ``i`` of a vector env reset with seed ``s`` draws from
 ``np_random(s + i)``, the generator of a single env reset with seed ``s + i`` (the convention of
 ``SyncVectorEnv``), so the two produce identical trajectories under identical actions.
+
+The vector env autoresets on the next step by default. With
+``autoreset_mode=AutoresetMode.SAME_STEP`` a finished sub-env is reset inside the step that
+ended it: the returned observation is the new episode's first one and the last observation of
+the finished episode is in ``info["final_obs"]`` (rows flagged by ``info["_final_obs"]``), the
+form that stable-baselines3's ``VecEnv`` needs (:mod:`shipgym.rl.vec_env`).
 """
 
 from __future__ import annotations
@@ -170,8 +176,20 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         num_envs: int = 1,
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         **task_kwargs: Any,
     ) -> None:
+        modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
+        try:
+            mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            mode = None
+        if mode not in modes:
+            raise ValueError(
+                f"autoreset_mode must be one of {[m.value for m in modes]}, got {autoreset_mode!r}"
+            )
+        self.autoreset_mode = mode
+        self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.task = self.task_cls(num_envs, **task_kwargs)
         self.num_envs = int(num_envs)
         steps = self.task.max_episode_steps if max_episode_steps is None else max_episode_steps
@@ -222,6 +240,15 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         terminated = task.term.copy()
         truncated = task.steps >= self.max_episode_steps
         rewards = task.rew.copy()
+        info: dict[str, Any] = {"reason": task.reason.copy()}
+        if self.autoreset_mode is AutoresetMode.SAME_STEP:
+            done = terminated | truncated
+            if done.any():
+                rows = np.flatnonzero(done)
+                info["final_obs"] = task.obs.astype(np.float32)
+                info["_final_obs"] = done
+                task.reset_rows(rows, [self._rngs[i] for i in rows])
+            return task.obs.astype(np.float32), rewards, terminated, truncated, info
         if self._prev_done.any():
             rows = np.flatnonzero(self._prev_done)
             task.reset_rows(rows, [self._rngs[i] for i in rows])
@@ -229,13 +256,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             terminated[self._prev_done] = False
             truncated[self._prev_done] = False
         self._prev_done = terminated | truncated
-        return (
-            task.obs.astype(np.float32),
-            rewards,
-            terminated,
-            truncated,
-            {"reason": task.reason.copy()},
-        )
+        return task.obs.astype(np.float32), rewards, terminated, truncated, info
 
     def render(self) -> np.ndarray | None:
         """Top-down view of sub-env 0 (``rgb_array`` only)."""

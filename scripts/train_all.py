@@ -1,0 +1,113 @@
+"""Train every agent shipgym ships: PPO and SAC on each of the five envs.
+
+    python scripts/train_all.py [--out DIR] [--only TEXT] [--algo ppo|sac] [--jobs N]
+                                [--timesteps N] [--seed S]
+
+Each agent is trained by :func:`shipgym.rl.train.train` with the budget and hyperparameters
+of :data:`shipgym.rl.train.TRAINING` and written as ``DIR/<name>.zip`` + ``DIR/<name>.json``
+(default DIR: the package's agent folder, ``shipgym/rl/agents``). ``--jobs 2`` trains two
+agents at a time, one per core (torch then uses one thread each). At the end it writes
+``docs/training.json``, the learning curves ``docs/training.png`` and the README table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _print(line: str) -> None:
+    print(line, flush=True)
+
+
+def _train_one(
+    env_id: str, algo: str, out: str, timesteps: int | None, seed: int, threads: int, bar: bool
+) -> dict:
+    import torch
+
+    torch.set_num_threads(threads)
+    from shipgym.rl.train import train
+
+    result = train(
+        env_id,
+        algo,
+        timesteps=timesteps,
+        seed=seed,
+        out_dir=out,
+        progress_bar=bar,
+        progress=None if bar else _print,
+    )
+    return result.meta
+
+
+def main(argv: list[str] | None = None) -> int:
+    from shipgym.envs import ENV_IDS
+    from shipgym.rl.agents import AGENT_DIR
+    from shipgym.rl.train import ALGOS
+
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", default=str(AGENT_DIR), help="agent folder (%(default)s)")
+    p.add_argument("--only", default=None, help="train only envs whose id contains TEXT")
+    p.add_argument("--algo", choices=ALGOS, default=None, help="train only this algorithm")
+    p.add_argument("--jobs", type=int, default=2, help="agents trained at once (%(default)s)")
+    p.add_argument("--timesteps", type=int, default=None, help="override every budget")
+    p.add_argument("--seed", type=int, default=0, help="training seed (%(default)s)")
+    p.add_argument("--no-report", action="store_true", help="skip docs/ and README")
+    args = p.parse_args(argv)
+    if args.jobs < 1:
+        p.error(f"--jobs must be >= 1, got {args.jobs}")
+    jobs = [
+        (env_id, algo)
+        for env_id in ENV_IDS
+        if args.only is None or args.only in env_id
+        for algo in ALGOS
+        if args.algo in (None, algo)
+    ]
+    if not jobs:
+        p.error(f"no env id contains {args.only!r}; ids: {', '.join(ENV_IDS)}")
+    threads = max(1, (os.cpu_count() or 1) // args.jobs)
+    bar = args.jobs == 1 and sys.stderr.isatty()  # one bar per terminal, else log lines
+    start = time.perf_counter()
+    print(f"training {len(jobs)} agents, {args.jobs} at a time, into {args.out}", flush=True)
+    failed = 0
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        futures = {
+            pool.submit(
+                _train_one, env_id, algo, args.out, args.timesteps, args.seed, threads, bar
+            ): (
+                env_id,
+                algo,
+            )
+            for env_id, algo in jobs
+        }
+        for done, future in enumerate(as_completed(futures), 1):
+            env_id, algo = futures[future]
+            try:
+                meta = future.result()
+            except Exception as exc:  # report and go on with the others
+                failed += 1
+                print(f"[{done}/{len(jobs)}] {env_id} {algo} FAILED: {exc!r}", flush=True)
+                continue
+            print(
+                f"[{done}/{len(jobs)}] {env_id} {algo}: {meta['timesteps']} steps in "
+                f"{meta['wall_time_s']:.0f} s, best validation return "
+                f"{meta['best_validation_return']:.1f} at {meta['best_timestep']}",
+                flush=True,
+            )
+    print(f"done in {time.perf_counter() - start:.0f} s", flush=True)
+    if not args.no_report:
+        from shipgym.rl.report import write_training_report
+
+        for path in write_training_report(Path(args.out), ROOT):
+            print(f"wrote {path}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,121 @@
+"""stable-baselines3 ``VecEnv`` adapter over shipgym's NumPy-batched vector envs.
+
+SB3 steps its environments through :class:`stable_baselines3.common.vec_env.VecEnv`. Its own
+``DummyVecEnv`` loops over single envs in Python and ``SubprocVecEnv`` starts a process per env;
+:class:`ShipgymVecEnv` instead drives one :class:`shipgym.envs.core.ShipVectorEnv`, so one
+kernel call steps every sub-env. The vector env runs with same-step autoreset
+(``AutoresetMode.SAME_STEP``), which is SB3's contract: the observation after a finished
+episode is the new episode's first one, the finished episode's last observation is in
+``infos[i]["terminal_observation"]``, and ``infos[i]["TimeLimit.truncated"]`` says the episode
+was cut by the time limit (so SB3 bootstraps its value).
+
+Seeding follows SB3: ``seed(s)`` makes the next ``reset()`` seed sub-env ``i`` with ``s + i``,
+which is the scenario of a single env reset with seed ``s + i``. With ``fixed_seed=s`` every
+``reset()`` reseeds that way, so an evaluation env shows the same episodes at every evaluation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices, VecEnvStepReturn
+
+import shipgym  # noqa: F401  (registers the environments)
+from shipgym.envs import ENV_IDS
+
+
+class ShipgymVecEnv(VecEnv):
+    """``num_envs`` sub-envs of ``env_id`` stepped by one batched kernel, as an SB3 ``VecEnv``.
+
+    Parameters
+    ----------
+    env_id : str
+        One of :data:`shipgym.envs.ENV_IDS`.
+    num_envs : int
+        Number of sub-envs (>= 1).
+    fixed_seed : int, optional
+        If given, every ``reset()`` seeds sub-env ``i`` with ``fixed_seed + i``.
+    reset_options : dict, optional
+        Options for every reset the caller makes (not for autoresets), e.g. a current.
+    **env_kwargs
+        Keyword arguments of the env (e.g. ``max_current_speed``).
+    """
+
+    def __init__(
+        self,
+        env_id: str,
+        num_envs: int = 16,
+        fixed_seed: int | None = None,
+        reset_options: dict[str, Any] | None = None,
+        **env_kwargs: Any,
+    ) -> None:
+        if env_id not in ENV_IDS:
+            raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+        if not isinstance(num_envs, int | np.integer) or num_envs < 1:
+            raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+        self.env_id = env_id
+        self.venv = gym.make_vec(
+            env_id,
+            num_envs=int(num_envs),
+            vectorization_mode="vector_entry_point",
+            autoreset_mode=AutoresetMode.SAME_STEP,
+            **env_kwargs,
+        )
+        self.fixed_seed = fixed_seed
+        self.reset_options = dict(reset_options or {})
+        super().__init__(
+            int(num_envs), self.venv.single_observation_space, self.venv.single_action_space
+        )
+        self._actions: np.ndarray | None = None
+
+    def reset(self) -> np.ndarray:
+        seed = self._seeds[0] if self._seeds[0] is not None else self.fixed_seed
+        obs, _ = self.venv.reset(seed=seed, options=self.reset_options or None)
+        self._reset_seeds()
+        self._reset_options()
+        self.reset_infos = [{} for _ in range(self.num_envs)]
+        return obs
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = actions
+
+    def step_wait(self) -> VecEnvStepReturn:
+        obs, rewards, terminated, truncated, info = self.venv.step(self._actions)
+        dones = terminated | truncated
+        infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        for i in np.flatnonzero(dones):
+            infos[i]["terminal_observation"] = info["final_obs"][i]
+            infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+        return obs, rewards.astype(np.float32), dones, infos
+
+    def close(self) -> None:
+        self.venv.close()
+
+    def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
+        value = getattr(self.venv, attr_name)
+        return [value for _ in self._get_indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
+        setattr(self.venv, attr_name, value)
+
+    def env_method(
+        self,
+        method_name: str,
+        *method_args: Any,
+        indices: VecEnvIndices = None,
+        **method_kwargs: Any,
+    ) -> list[Any]:
+        result = getattr(self.venv, method_name)(*method_args, **method_kwargs)
+        return [result for _ in self._get_indices(indices)]
+
+    def env_is_wrapped(
+        self, wrapper_class: type[gym.Wrapper], indices: VecEnvIndices = None
+    ) -> list[bool]:
+        return [False for _ in self._get_indices(indices)]
+
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        return [None for _ in range(self.num_envs)]
