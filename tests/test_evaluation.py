@@ -193,4 +193,4 @@ def test_evaluate_rejects_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(ValueError, match="episodes"):
         evaluate("shipgym/RVGSpeed-v0", make_policy("zero", "shipgym/RVGSpeed-v0"), "zero", 0)
     with pytest.raises(ValueError, match="unknown controller"):
-        make_policy("ppo", "shipgym/RVGSpeed-v0")
+        make_policy("dqn", "shipgym/RVGSpeed-v0")

@@ -1,0 +1,201 @@
+"""``shipgym benchmark`` and ``shipgym train`` (issue 5, sections 1 and 3).
+
+The benchmark on identical seeds and current draws for every controller, the stress condition,
+its JSON/CSV/figures and the seed guard; the PPO throughput measurement; the command lines and
+their errors.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipgym.benchmark.evaluate import METRICS
+from shipgym.benchmark.report import render_markdown
+from shipgym.benchmark.runner import STRESS_FACTOR, run_benchmark, training_max_current
+from shipgym.benchmark.throughput import CARTPOLE, ppo_throughput
+from shipgym.cli import main
+from shipgym.rl.train import BENCHMARK_SEED
+
+ENV = "shipgym/RVGHeading-v0"
+
+
+def _quiet(line: str) -> None:
+    pass
+
+
+@pytest.fixture(scope="module")
+def bench():
+    return run_benchmark(episodes=3, envs=[ENV], progress=_quiet)
+
+
+def test_every_controller_sees_the_same_scenarios(bench) -> None:
+    assert bench.controllers == ["classic", "ppo", "sac", "zero"]
+    assert bench.conditions == ["nominal", "stress"]
+    for cond in bench.conditions:
+        starts = [
+            [
+                (log.seed, log.reset_info["current_direction"], tuple(log.reset_info["state"]))
+                for log in bench.get(ENV, name, cond).logs
+            ]
+            for name in bench.controllers
+        ]
+        assert all(s == starts[0] for s in starts)
+        assert [s[0] for s in starts[0]] == [BENCHMARK_SEED + k for k in range(3)]
+
+
+def test_stress_fixes_the_current_at_one_and_a_half_the_training_maximum(bench) -> None:
+    stress = STRESS_FACTOR * training_max_current(ENV)
+    assert math.isclose(bench.stress_current[ENV], stress)
+    nominal = bench.get(ENV, "classic", "nominal").logs
+    stressed = bench.get(ENV, "classic", "stress").logs
+    for a, b in zip(nominal, stressed, strict=True):
+        assert a.reset_info["current_speed"] <= training_max_current(ENV)
+        assert math.isclose(b.reset_info["current_speed"], stress)
+        assert math.isclose(a.reset_info["current_direction"], b.reset_info["current_direction"])
+
+
+def test_agents_and_the_classic_controller_beat_zero(bench) -> None:
+    zero = bench.get(ENV, "zero").to_dict()["mean_return"]
+    for name in ("classic", "ppo", "sac"):
+        assert bench.get(ENV, name).to_dict()["mean_return"] > zero
+
+
+def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
+    entries = json.loads(bench.write_json(tmp_path / "b.json").read_text())
+    assert len(entries) == 8
+    for e in entries:
+        assert set(METRICS[ENV]) == set(e["metrics"]) == set(e["metrics_std"])
+        assert e["episodes"] == 3 and e["seed"] == BENCHMARK_SEED
+    with bench.write_csv(tmp_path / "b.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 8 * (1 + len(METRICS[ENV]))
+    ppo = [r for r in rows if r["controller"] == "ppo" and r["condition"] == "nominal"]
+    assert {r["metric"] for r in ppo} == {"return", *METRICS[ENV]}
+    expected = bench.get(ENV, "ppo").to_dict()["metrics"]["heading_rms_deg"]
+    assert math.isclose(
+        float(next(r["mean"] for r in ppo if r["metric"] == "heading_rms_deg")), expected
+    )
+    table = bench.table()
+    assert "heading_rms_deg" in table and "stress" in table and " +- " in table
+    md = render_markdown(entries, None)
+    assert md.count(f"| {ENV.split('/')[-1]} |") == 4
+
+
+def test_seed_guard_refuses_training_seeds() -> None:
+    with pytest.raises(ValueError, match="overlap the training seeds"):
+        run_benchmark(episodes=2, seed=0, envs=[ENV], controllers=["ppo"], progress=_quiet)
+    with pytest.raises(ValueError, match="overlap the validation seeds"):
+        run_benchmark(
+            episodes=2, seed=100_001, envs=[ENV], controllers=["sac"], progress=_quiet
+        )
+
+
+def test_benchmark_rejects_bad_arguments() -> None:
+    with pytest.raises(ValueError, match="unknown controller"):
+        run_benchmark(episodes=1, controllers=["dqn"], progress=_quiet)
+    with pytest.raises(ValueError, match="unknown env"):
+        run_benchmark(episodes=1, envs=["CartPole-v1"], progress=_quiet)
+    with pytest.raises(ValueError, match="episodes"):
+        run_benchmark(episodes=0, progress=_quiet)
+
+
+def test_ppo_throughput_measures_both_in_one_run() -> None:
+    rows = ppo_throughput(["shipgym/RVGSpeed-v0"], timesteps=2048, repeats=1, progress=_quiet)
+    assert [r["env"] for r in rows] == [CARTPOLE, "shipgym/RVGSpeed-v0"]
+    assert rows[0]["ratio"] == 1.0 and rows[0]["met"] is None
+    assert all(r["steps_per_s"] > 0 and len(r["runs"]) == 1 for r in rows)
+    assert math.isclose(rows[1]["ratio"], rows[1]["steps_per_s"] / rows[0]["steps_per_s"])
+    assert rows[1]["met"] is (rows[1]["ratio"] >= 0.9)
+
+
+# ------------------------------------------------------------------------------------------
+# command line
+# ------------------------------------------------------------------------------------------
+def test_benchmark_command_writes_table_json_csv_and_figures(tmp_path: Path, capsys) -> None:
+    code = main(
+        [
+            "benchmark",
+            "--episodes",
+            "2",
+            "--env",
+            "shipgym/RVGSpeed-v0",
+            "--no-throughput",
+            "--out",
+            str(tmp_path),
+            "--quiet",
+        ]
+    )
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "speed_rms_m_s" in out and "sac" in out
+    entries = json.loads((tmp_path / "benchmark.json").read_text())
+    assert {(e["controller"], e["condition"]) for e in entries} == {
+        (c, k) for c in ("classic", "ppo", "sac", "zero") for k in ("nominal", "stress")
+    }
+    assert (tmp_path / "benchmark.csv").stat().st_size > 0
+    for name in ("metrics.png", "RVGSpeed-v0.png"):
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_benchmark_command_bad_input(tmp_path: Path, capsys) -> None:
+    afile = tmp_path / "x.txt"
+    afile.write_text("keep me")
+    assert main(["benchmark", "--out", str(afile)]) == 2
+    assert "--out names a file" in capsys.readouterr().err
+    assert afile.read_text() == "keep me"
+    assert main(["benchmark", "--json", str(tmp_path / "b.txt"), "--out", str(tmp_path)]) == 2
+    assert "--json must name a .json file" in capsys.readouterr().err
+    assert main(["benchmark", "--episodes", "0"]) == 2
+    assert main(["benchmark", "--seed", "3", "--env", ENV, "--controller", "ppo"]) == 2
+    assert "overlap the training seeds" in capsys.readouterr().err
+
+
+def test_train_and_evaluate_commands(tmp_path: Path, capsys) -> None:
+    code = main(
+        [
+            "train",
+            "--env",
+            "shipgym/RVGSpeed-v0",
+            "--algo",
+            "ppo",
+            "--timesteps",
+            "64",
+            "--num-envs",
+            "2",
+            "--eval-episodes",
+            "2",
+            "--out",
+            str(tmp_path),
+            "--quiet",
+        ]
+    )
+    assert code == 0
+    assert (tmp_path / "RVGSpeed-v0-ppo.zip").is_file()
+    meta = json.loads((tmp_path / "RVGSpeed-v0-ppo.json").read_text())
+    assert meta["timesteps"] >= 64 and meta["num_envs"] == 2
+    capsys.readouterr()
+    argv = ["evaluate", "--env", "shipgym/RVGSpeed-v0", "--controller", "ppo", "--episodes", "1"]
+    assert main([*argv, "--agents", str(tmp_path), "--seed", "500"]) == 0
+    assert "speed_rms_m_s" in capsys.readouterr().out
+    # seeds inside the agent's own training seeds: evaluated, with a warning
+    assert main([*argv, "--agents", str(tmp_path), "--seed", "0"]) == 0
+    assert "warning" in capsys.readouterr().err
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main([*argv, "--agents", str(empty)]) == 1
+    assert "shipgym train --env shipgym/RVGSpeed-v0 --algo ppo" in capsys.readouterr().err
+    assert main(["train", "--env", "shipgym/RVGSpeed-v0", "--algo", "dqn"]) == 2
+
+
+def test_evaluate_shipped_agent_from_the_command_line(capsys) -> None:
+    argv = ["evaluate", "--env", ENV, "--controller", "sac", "--episodes", "2"]
+    assert main([*argv, "--seed", str(BENCHMARK_SEED)]) == 0
+    out = capsys.readouterr().out
+    value = float(out.split("heading_rms_deg")[1].split()[0])
+    assert np.isfinite(value) and value < 30.0
