@@ -91,9 +91,7 @@ def test_seed_guard_refuses_training_seeds() -> None:
     with pytest.raises(ValueError, match="overlap the training seeds"):
         run_benchmark(episodes=2, seed=0, envs=[ENV], controllers=["ppo"], progress=_quiet)
     with pytest.raises(ValueError, match="overlap the validation seeds"):
-        run_benchmark(
-            episodes=2, seed=100_001, envs=[ENV], controllers=["sac"], progress=_quiet
-        )
+        run_benchmark(episodes=2, seed=100_001, envs=[ENV], controllers=["sac"], progress=_quiet)
 
 
 def test_benchmark_rejects_bad_arguments() -> None:

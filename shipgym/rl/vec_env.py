@@ -40,7 +40,8 @@ class ShipgymVecEnv(VecEnv):
     fixed_seed : int, optional
         If given, every ``reset()`` seeds sub-env ``i`` with ``fixed_seed + i``.
     reset_options : dict, optional
-        Options for every reset the caller makes (not for autoresets), e.g. a current.
+        Options for every reset the caller makes (not for autoresets), e.g. a current;
+        SB3's ``set_options`` overrides them for the next reset.
     **env_kwargs
         Keyword arguments of the env (e.g. ``max_current_speed``).
     """
@@ -74,7 +75,8 @@ class ShipgymVecEnv(VecEnv):
 
     def reset(self) -> np.ndarray:
         seed = self._seeds[0] if self._seeds[0] is not None else self.fixed_seed
-        obs, _ = self.venv.reset(seed=seed, options=self.reset_options or None)
+        options = self._options[0] or self.reset_options  # SB3's set_options() first
+        obs, _ = self.venv.reset(seed=seed, options=options or None)
         self._reset_seeds()
         self._reset_options()
         self.reset_infos = [{} for _ in range(self.num_envs)]
