@@ -77,7 +77,7 @@ def test_vector_env_same_step_mode_reports_the_final_observation() -> None:
         max_episode_steps=2,
     )
     assert envs.metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
-    first, _ = envs.reset(seed=0)
+    envs.reset(seed=0)
     envs.step(np.zeros((2, 1), dtype=np.float32))
     obs, _, _, truncated, info = envs.step(np.zeros((2, 1), dtype=np.float32))
     assert truncated.all() and info["_final_obs"].all()
@@ -175,6 +175,7 @@ SHIPPED = [(env_id, algo) for env_id in ENV_IDS for algo in ALGOS]
 @pytest.mark.parametrize(("env_id", "algo"), SHIPPED)
 def test_shipped_agent_is_small_recorded_and_beats_zero(env_id: str, algo: str) -> None:
     model_path, meta_path = agent_files(env_id, algo)
+    assert meta_path.is_file()
     assert model_path.parent == AGENT_DIR
     assert model_path.stat().st_size < 1_000_000  # small files inside the package
     meta = load_meta(env_id, algo)
