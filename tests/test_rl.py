@@ -142,9 +142,7 @@ def test_training_changes_the_policy(tmp_path: Path) -> None:
     """The tiny budget really updates the network (the smoke tests could not fail otherwise)."""
     from stable_baselines3 import PPO
 
-    from shipgym.rl.vec_env import ShipgymVecEnv as Vec
-
-    model = PPO("MlpPolicy", Vec("shipgym/RVGSpeed-v0", 2), seed=0, **TINY["ppo"])
+    model = PPO("MlpPolicy", ShipgymVecEnv("shipgym/RVGSpeed-v0", 2), seed=0, **TINY["ppo"])
     before = [p.detach().clone() for p in model.policy.parameters()]
     model.learn(64)
     after = list(model.policy.parameters())

@@ -109,7 +109,7 @@ def ppo_throughput(
     return out
 
 
-def throughput_table(rows: list[dict[str, Any]], timesteps: int | None = None) -> str:
+def throughput_table(rows: list[dict[str, Any]]) -> str:
     """Plain-text table of :func:`ppo_throughput`'s rows."""
     lines = ["PPO training throughput (env steps/s, best of the runs; same PPO settings)"]
     for r in rows:
