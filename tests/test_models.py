@@ -355,30 +355,132 @@ def test_rvg_pod_forces_at_rest_follow_eq20() -> None:
     assert model.deriv(x, [50e3, 0.0, 0.0, 0.0])[0, 5] > 0.0
 
 
-def test_rvg_pod_lift_adds_the_foil_side_force_at_each_pod() -> None:
-    """With ``c_L > 0`` the derivative differs from seed 001's by ``M^-1 [0, L, x_t L]`` summed
-    over the pods, ``L = c_L u_r |u_r| sin(alpha)``, and the lift turns the ship the same way as
-    the thrust's side component (positive azimuth: to port)."""
+def _pod_lift_force(params: RVGParams, x: np.ndarray) -> np.ndarray:
+    """Independent evaluation of the pod normal force of the module docstring (on the hull)."""
+    from shipgym.models.rvg import WATER_DENSITY
+
+    u, v, r = x[3:6]
+    force = np.zeros(3)
+    for k in range(2):
+        xt, yt = params.pod_x[k], params.pod_y[k]
+        up, vp = u - yt * r, v + xt * r
+        beta = math.atan2(vp, up)
+        aoa = (x[8 + k] - beta + math.pi) % (2 * math.pi) - math.pi
+        aoa = float(np.clip(aoa, -params.pod_stall_angle, params.pod_stall_angle))
+        slip = 8 * x[6 + k] / (WATER_DENSITY * math.pi * params.propeller_diameter**2)
+        lift = params.pod_lift_coefficient * (up**2 + vp**2 + params.pod_slipstream * slip)
+        lift *= math.sin(aoa)
+        fx, fy = -lift * math.sin(x[8 + k]), lift * math.cos(x[8 + k])
+        force += np.array([fx, fy, xt * fy - yt * fx])
+    return force
+
+
+def test_rvg_pod_lift_adds_the_foil_force_from_each_pods_inflow() -> None:
+    """With ``c_L > 0`` the derivative differs from seed 001's by ``M^-1`` times the normal force
+    of each pod from its own inflow angle (with stall and slipstream), normal to the pod's chord;
+    it turns the ship the same way as the thrust's side component (positive azimuth: to port)."""
     c_l = 6.5e3
     base = make_model("rvg3dof", RVGParams())
-    lift = make_model("rvg3dof", RVGParams(pod_lift_coefficient=c_l))
+    lift = make_model(
+        "rvg3dof", RVGParams(pod_lift_coefficient=c_l, pod_slipstream=0.5)
+    )
     params = lift.params
     rng = np.random.default_rng(3)
-    for _ in range(10):
-        u, v, r = rng.uniform(-2, 6), rng.uniform(-1, 1), rng.uniform(-0.05, 0.05)
-        alpha = rng.uniform(-0.6, 0.6, 2)
-        x = np.array([0.0, 0.0, 0.3, u, v, r, 30e3, 30e3, *alpha])
-        inputs = [30e3, 30e3, *alpha]
+    for _ in range(20):
+        u, v, r = rng.uniform(0.5, 6), rng.uniform(-1, 1), rng.uniform(-0.05, 0.05)
+        alpha = rng.uniform(-0.9, 0.9, 2)
+        thrust = rng.uniform(0, 60e3, 2)
+        x = np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha])
+        inputs = [*thrust, *alpha]
         diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
-        force = np.zeros(3)
-        for k in range(2):
-            side = c_l * u * abs(u) * math.sin(alpha[k])
-            force += np.array([0.0, side, params.pod_x[k] * side])
-        np.testing.assert_allclose(params.mass_matrix @ diff, force, rtol=1e-9, atol=1e-6)
+        expected = _pod_lift_force(params, x)
+        np.testing.assert_allclose(params.mass_matrix @ diff, expected, rtol=1e-9, atol=1e-6)
     x = np.array([0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 30e3, 30e3, 0.1, 0.1])
     r_dot_base = base.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
     r_dot_lift = lift.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
     assert r_dot_lift < r_dot_base < 0.0
+
+
+def test_rvg_pod_lift_damps_sway_and_yaw_and_stalls() -> None:
+    """Straight ahead the normal force is ``c_L u^2 sin(alpha)`` per pod, normal to the chord
+    (so it also brakes); a sway velocity at zero azimuth gives a restoring side force
+    ``dY/dv = -2 c_L u`` (both pods); beyond the stall angle the normal force no longer grows."""
+    c_l = 6.5e3
+    params = RVGParams(pod_lift_coefficient=c_l)
+    u = 5.0
+    for a in (0.05, 0.2):
+        x = np.array([0.0, 0.0, 0.0, u, 0.0, 0.0, 0.0, 0.0, a, a])
+        side = 2 * c_l * u * u * math.sin(a)  # normal to the chord
+        np.testing.assert_allclose(
+            _pod_lift_force(params, x)[:2], [-side * math.sin(a), side * math.cos(a)]
+        )
+    model = make_model("rvg3dof", params)
+    seed = make_model("rvg3dof", RVGParams())
+    dv = 1e-4
+    x = np.array([0.0, 0.0, 0.0, u, dv, 0.0, 0.0, 0.0, 0.0, 0.0])
+    side = params.mass_matrix @ (model.deriv(x, [0, 0, 0, 0]) - seed.deriv(x, [0, 0, 0, 0]))[0, 3:6]
+    assert side[1] / dv == pytest.approx(-2 * c_l * u, rel=1e-3)
+    assert side[2] / dv == pytest.approx(-2 * c_l * u * params.pod_x[0], rel=1e-3)  # > 0: stable
+    stalled = [
+        float(np.hypot(*_pod_lift_force(params, np.array([0, 0, 0, u, 0, 0, 0, 0, a, a]))[:2]))
+        for a in np.radians([35.0, 45.0, 60.0])
+    ]
+    assert stalled[1] == pytest.approx(stalled[0]) and stalled[2] == pytest.approx(stalled[0])
+
+
+def test_rvg_turning_speed_loss_and_crossflow_cross_terms() -> None:
+    """``X_vv v^2 + X_vr v r + X_rr r^2`` enters surge as written; the cross-flow terms equal the
+    strip integral ``-rho/2 T C_cf int |v + x r|(v + x r) (1, x) dx`` over the hull less its pure
+    sway and pure yaw parts (so they vanish when v or r is zero)."""
+    from scipy.integrate import quad
+
+    from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, LPP, WATER_DENSITY
+
+    seed = make_model("rvg3dof", RVGParams())
+    surge = RVGParams(surge_vv=-3e4, surge_vr=2e5, surge_rr=-1e6)
+    cross = RVGParams(crossflow_coefficient=0.8)
+    xa, xf = -CG_FORWARD_OF_AP, LPP - CG_FORWARD_OF_AP
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        u, v, r = rng.uniform(1, 6), rng.uniform(-1, 1), rng.uniform(-0.08, 0.08)
+        x = np.array([0.0, 0.0, 0.0, u, v, r, 0.0, 0.0, 0.0, 0.0])
+        base = seed.deriv(x, [0, 0, 0, 0])[0, 3:6]
+        f = surge.mass_matrix @ (make_model("rvg3dof", surge).deriv(x, [0, 0, 0, 0])[0, 3:6] - base)
+        x_force = surge.surge_vv * v * v + surge.surge_vr * v * r + surge.surge_rr * r * r
+        np.testing.assert_allclose(f, [x_force, 0.0, 0.0], atol=1e-6 * abs(x_force) + 1e-9)
+        f = cross.mass_matrix @ (make_model("rvg3dof", cross).deriv(x, [0, 0, 0, 0])[0, 3:6] - base)
+
+        def g(s: float) -> float:
+            return abs(s) * s
+
+        k = -0.5 * WATER_DENSITY * DRAUGHT * 0.8
+        y = k * quad(lambda xx: g(v + xx * r) - g(v) - g(xx * r), xa, xf, limit=200)[0]
+        n = k * quad(lambda xx: xx * (g(v + xx * r) - g(v) - g(xx * r)), xa, xf, limit=200)[0]
+        np.testing.assert_allclose(f[1:], [y, n], rtol=1e-2, atol=1.0)  # 12-point quadrature
+    for v, r in ((0.7, 0.0), (0.0, 0.05)):
+        x = np.array([0.0, 0.0, 0.0, 4.0, v, r, 0.0, 0.0, 0.0, 0.0])
+        np.testing.assert_allclose(
+            make_model("rvg3dof", cross).deriv(x, [0, 0, 0, 0]), seed.deriv(x, [0, 0, 0, 0])
+        )
+
+
+def test_rvg_propeller_hull_interaction() -> None:
+    """Thrust deduction scales the pod force on the hull by ``1 - t``; the wake fraction lowers
+    the advance speed of the propeller law and the thrust limit to ``(1 - w) u_r``."""
+    from shipgym.models.rvg import pack_rvg, pod_thrust
+
+    t, w = 0.12, 0.2
+    params = RVGParams(thrust_deduction=t, wake_fraction=w)
+    seed = RVGParams()
+    x = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 40e3, 30e3, 0.2, -0.1])
+    d_int = make_model("rvg3dof", params).deriv(x, [40e3, 30e3, 0.2, -0.1])[0, 3:6]
+    d_seed = make_model("rvg3dof", seed).deriv(x, [40e3, 30e3, 0.2, -0.1])[0, 3:6]
+    np.testing.assert_allclose(d_int, (1 - t) * d_seed, rtol=1e-12)
+    for ur in (1.0, 4.0):
+        assert pod_thrust(170.0, ur, pack_rvg(params)) == pytest.approx(
+            pod_thrust(170.0, (1 - w) * ur, pack_rvg(seed)), rel=1e-12
+        )
+        assert params.max_thrust(ur) == pytest.approx(seed.max_thrust((1 - w) * ur))
 
 
 def test_rvg_pod_thrust_follows_the_kongsberg_bollard_table_and_the_thrust_limit() -> None:

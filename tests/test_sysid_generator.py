@@ -226,11 +226,9 @@ def _rvg_replay(rec: Record, params: RVGParams, alpha_0: float = 0.0) -> np.ndar
 
     def controller(t: float, x: np.ndarray) -> list[float]:
         k = round(t / rec.dt)
-        psi = x[rvg_model.IPSI]
-        u_r = x[rvg_model.IU] - (current[0] * math.cos(psi) + current[1] * math.sin(psi))
-        thrust = rvg_model.pod_thrust(rec.rpm[k], u_r, model.p)
+        t1, t2 = rvg_model.pod_thrusts(rec.rpm[k], x, current, model.p)
         alpha = rec.azimuth[k] + alpha_0
-        return [thrust, thrust, alpha, alpha]
+        return [t1, t2, alpha, alpha]
 
     sim = model.simulate(truth["x0"], controller, rec.dt, n_steps=rec.n - 1, current=current)
     return sim.states

@@ -20,17 +20,42 @@ Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`
 to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
 200 rpm (RVG_PARAMETERS.md).
 
-Pod foil lift (the "rudder" loads that seed 001 says eq. 19 leaves out): each pod adds a side
-force ``L = c_L u_r |u_r| sin(alpha)`` in body ``y`` at the pod, so ``F += [0, L, x_t L]``; it
-acts with the thrust's ``T sin(alpha)`` (a foil swung to starboard meets the inflow on its port
-face). ``c_L = 0`` by default, which is seed 001's model; ``POD_LIFT_COEFFICIENT_THRUSTER_DATA``
-is the value implied by the Kongsberg pod data (34.3 kN side force at 5 m/s, 180 rpm, 10 deg, of
-which ``T sin(alpha)`` is 6.2 kN).
+Pod foil lift (the "rudder" loads that seed 001 says eq. 19 leaves out). The pods' struts are
+foils; as the MMG rudder (Yasukawa and Yoshimura 2015, eq. 33-42) each makes a force normal to
+its chord from the pod's own inflow ``u_p = u_r - y_t r``, ``v_p = v_r + x_t r`` (drift angle
+``beta_p = atan2(v_p, u_p)``) ::
 
-Propeller law (:func:`pod_thrust`, used where the input is an rpm, e.g. the sea-trial replay of
-:mod:`shipgym.sysid`): ``T = T_bollard (s^2 - s u_r / u_0)`` with ``s = n / n_ref``,
-``n_ref = 200`` rpm. Its bollard values ``T_bollard s^2`` are the Kongsberg table (68.5 / 98.6 /
-121.7 / 147.3 kN at 150 / 180 / 200 / 220 rpm) and at 200 rpm it is the thrust limit above.
+    F_N = c_L q sin(a_e),   q = u_p^2 + v_p^2 + k_s 8 T / (rho pi D^2),   a_e = sat(alpha - beta_p)
+
+``F += F_N [-sin alpha, cos alpha, x_t cos alpha + y_t sin alpha]``. ``a_e`` is the angle of
+attack limited at the stall angle, ``q`` the dynamic pressure over ``rho / 2`` with a fraction
+``k_s`` of the far-wake slipstream of momentum theory. The normal force acts with the thrust's
+``T sin(alpha)``, brakes the ship when the pod is swung across the flow (``-F_N sin alpha``)
+and, because it depends on ``v_p``, damps sway and yaw like a skeg (``dY/dv = -2 c_L u`` over both
+pods, three times the seed's linear sway damping at service speed). The propeller sees the
+inflow along the pod's axis, ``u_a = (1 - w)(u_p cos alpha + v_p sin alpha)``
+(:func:`pod_axial_inflow`). ``c_L = 0`` by default, which is seed 001's model. Fitted to the
+Kongsberg pod FMU table of MCSim_python (one pod, 47 points at 0-6.5 m/s, 150-220 rpm, 0-30 deg,
+v 0-2 m/s: ``POD_LIFT_COEFFICIENT_FMU``, ``POD_SLIPSTREAM_FMU``, ``D = 1.9`` m) the form
+reproduces the pod's surge and side forces to 2.9 and 2.3 kN RMS (forces up to 116 kN).
+``POD_LIFT_COEFFICIENT_THRUSTER_DATA`` is the simpler value implied by its one point (34.3 kN
+side force at 5 m/s, 180 rpm, 10 deg, less ``T sin(alpha)``, without slipstream).
+
+Propeller-hull interaction (MMG, Yasukawa and Yoshimura 2015 eq. 25-28): the pods push the hull
+with ``(1 - t) T`` (thrust deduction ``t``) and their propellers see the advance speed
+``(1 - w) u_r`` (wake fraction ``w``, in :func:`pod_thrust` and the thrust limit); both 0 in
+seed 001.
+
+Turning speed loss and cross-flow damping (Fossen 2011 ch. 6.4, Yasukawa and Yoshimura 2015 eq.
+9): the surge force gains ``X_vv v_r^2 + X_vr v_r r + X_rr r^2`` (zero in seed 001) and sway and
+yaw gain the cross terms of the strip-theory cross-flow drag ::
+
+    Y_cf = -rho/2 T C_cf int |v_r + x r| (v_r + x r) dx,   N_cf = -rho/2 T C_cf int x |..| (..) dx
+
+over the hull (``x`` from the aft to the forward perpendicular) less its pure ``|v|v`` and
+``|r|r`` parts, which the seed's quadratic damping ``D_v``, ``D_r`` already holds: the terms
+``Y_|v|r``, ``Y_|r|v``, ``N_|v|v``, ``N_|r|v`` ... that couple sway and yaw. ``C_cf = 0`` in
+seed 001.
 
 State ``[x, y, psi, u, v, r, T_1, T_2, alpha_1, alpha_2]`` in [m, m, rad, m/s, m/s, rad/s, N, N,
 rad, rad]; input ``[T_1c, T_2c, alpha_1c, alpha_2c]``. Pod 1 is port (y < 0), pod 2 starboard.
@@ -58,6 +83,22 @@ DRAUGHT = 2.7  # [m], seed 001 Table 1
 VERES_DRAUGHT = 2.786  # [m], the draught of the VERES run behind the damping (RVG_PARAMETERS.md)
 BREADTH = 9.6  # [m], seed 001 Table 1
 SERVICE_SPEED = 5.144  # [m/s], 10 kn (RVG_PARAMETERS.md)
+CG_FORWARD_OF_AP = 15.56  # [m], the body origin (RVG_PARAMETERS.md "Frame and units")
+WATER_DENSITY = 1025.0  # [kg/m^3], sea water (the new terms; the seed's damping used 1000)
+PROPELLER_DIAMETER = 1.9  # [m], pod propellers (the Kongsberg pod FMU's setting, MCSim_python)
+POD_STALL_ANGLE = math.radians(35.0)
+"""Angle of attack [rad] beyond which the pod's normal force stops growing. The Kongsberg pod
+data show no stall up to 30 deg (their range); low-aspect-ratio rudders stall at 30-40 deg
+(Molland and Turnock 2007, ch. 3)."""
+POD_LIFT_COEFFICIENT_FMU = 5.22e3
+"""``c_L`` [N s^2/m^2] of the least-squares fit of the normal-force form to the Kongsberg pod FMU
+table (``scripts/pod_fmu_fit.py``)."""
+POD_SLIPSTREAM_FMU = 0.153
+"""``k_s`` [-] of the same fit: the fraction of the far-wake slipstream dynamic pressure the
+strut sees (the thruster_lift effect keeps it fixed and fits ``c_L``)."""
+
+#: Gauss-Legendre nodes and weights on [-1, 1] for the cross-flow drag integral over the hull.
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 _D_V = 0.5 * 0.5 * LPP * VERES_DRAUGHT * 1000.0  # 23 611.35, RVG_PARAMETERS.md
 #: Yaw quadratic damping ``D_r[2,2]`` [N m s^2], a deliberate choice. The source writes it as
@@ -123,6 +164,21 @@ class RVGParams:
         ``POD_LIFT_COEFFICIENT_THRUSTER_DATA``.
     reference_rpm : float
         Shaft speed [rpm] at which ``bollard_thrust`` is reached (200 rpm), for :func:`pod_thrust`.
+    pod_stall_angle : float
+        Angle of attack [rad] beyond which the pod lift stays at its stall value (30 deg).
+    pod_slipstream : float
+        Fraction ``k_s`` [-] of the propeller slipstream's far-wake dynamic pressure seen by
+        the strut (0 in seed 001; ``POD_SLIPSTREAM_AT_STRUT`` with the lift effect).
+    propeller_diameter : float
+        Pod propeller diameter ``D`` [m] (for the slipstream).
+    thrust_deduction, wake_fraction : float
+        ``t`` and ``w`` [-] of the propeller-hull interaction (0 in seed 001).
+    surge_vv, surge_vr, surge_rr : float
+        ``X_vv`` [kg/m], ``X_vr`` [kg], ``X_rr`` [kg m] of the turning speed loss (0 in seed 001).
+    crossflow_coefficient : float
+        ``C_cf`` [-], the cross-flow drag coefficient of the sway-yaw cross terms (0 in seed 001).
+    name : str
+        Name of the parameter set (``"seed001"``; :meth:`sea_trials` gives ``"sea_trials"``).
     """
 
     mass: float = 574_127.69
@@ -149,6 +205,16 @@ class RVGParams:
     service_thrust: float = 25.0e3
     pod_lift_coefficient: float = 0.0
     reference_rpm: float = 200.0
+    pod_stall_angle: float = POD_STALL_ANGLE
+    pod_slipstream: float = 0.0
+    propeller_diameter: float = PROPELLER_DIAMETER
+    thrust_deduction: float = 0.0
+    wake_fraction: float = 0.0
+    surge_vv: float = 0.0
+    surge_vr: float = 0.0
+    surge_rr: float = 0.0
+    crossflow_coefficient: float = 0.0
+    name: str = "seed001"
 
     def __post_init__(self) -> None:
         for name in ("added_mass", "linear_damping"):
@@ -172,11 +238,21 @@ class RVGParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
-        if not (math.isfinite(self.pod_lift_coefficient) and self.pod_lift_coefficient >= 0):
-            raise ValueError(
-                "RVGParams.pod_lift_coefficient must be a finite number >= 0, got "
-                f"{self.pod_lift_coefficient!r}"
-            )
+        for name in ("pod_lift_coefficient", "pod_slipstream", "crossflow_coefficient"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"RVGParams.{name} must be a finite number >= 0, got {value!r}")
+        for name in ("pod_stall_angle", "propeller_diameter"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
+        for name in ("thrust_deduction", "wake_fraction"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0.0 <= value < 1.0):
+                raise ValueError(f"RVGParams.{name} must be a fraction in [0, 1), got {value!r}")
+        for name in ("surge_vv", "surge_vr", "surge_rr"):
+            if not math.isfinite(getattr(self, name)):
+                raise ValueError(f"RVGParams.{name} must be finite, got {getattr(self, name)!r}")
 
     @property
     def rigid_body_mass(self) -> np.ndarray:
@@ -189,8 +265,10 @@ class RVGParams:
         return self.rigid_body_mass + self.added_mass
 
     def max_thrust(self, relative_surge: float) -> float:
-        """Per-pod thrust limit [N] at relative surge speed ``u_r`` [m/s]."""
-        factor = min(max(1.0 - relative_surge / self.thrust_zero_speed, 0.0), 1.0)
+        """Per-pod thrust limit [N] at relative surge speed ``u_r`` [m/s] (advance speed
+        ``(1 - w) u_r``)."""
+        ua = (1.0 - self.wake_fraction) * relative_surge
+        factor = min(max(1.0 - ua / self.thrust_zero_speed, 0.0), 1.0)
         return self.bollard_thrust * factor
 
 
@@ -209,7 +287,11 @@ P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = (
     45,
 )  # 1/x saves divisions
 P_LIFT, P_INV_NREF = 46, 47
-P_SIZE = 48
+P_STALL, P_SLIP, P_HULL_T, P_ADV = 48, 49, 50, 51  # stall angle, k_s 8/(rho pi D^2), 1-t, 1-w
+P_XVV, P_XVR, P_XRR, P_CF = 52, 53, 54, 55  # surge terms; rho/2 T C_cf
+P_CF_X = 56  # 12 Gauss-Legendre stations x [m] along the hull
+P_CF_W = P_CF_X + _GL_X.size  # and their weights [m]
+P_SIZE = P_CF_W + _GL_X.size
 
 
 def pack_rvg(params: RVGParams) -> np.ndarray:
@@ -237,6 +319,15 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_INV_U0] = 1.0 / params.thrust_zero_speed
     p[P_LIFT] = params.pod_lift_coefficient
     p[P_INV_NREF] = 1.0 / params.reference_rpm
+    p[P_STALL] = params.pod_stall_angle
+    p[P_SLIP] = params.pod_slipstream * 8.0 / (WATER_DENSITY * math.pi * params.propeller_diameter**2)
+    p[P_HULL_T] = 1.0 - params.thrust_deduction
+    p[P_ADV] = 1.0 - params.wake_fraction
+    p[P_XVV], p[P_XVR], p[P_XRR] = params.surge_vv, params.surge_vr, params.surge_rr
+    half = 0.5 * LPP
+    p[P_CF] = 0.5 * WATER_DENSITY * DRAUGHT * params.crossflow_coefficient
+    p[P_CF_X : P_CF_X + _GL_X.size] = (LPP - CG_FORWARD_OF_AP - half) + half * _GL_X
+    p[P_CF_W : P_CF_W + _GL_X.size] = half * _GL_W
     return p
 
 
@@ -244,16 +335,42 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
 def pod_thrust(rpm, ur, p):
     """Propeller law: thrust [N] of one pod at shaft speed ``rpm`` and relative surge ``ur``.
 
-    ``T = T_bollard (s^2 - s u_r / u_0)``, ``s = rpm / n_ref``, floored at 0 (module docstring).
+    ``T = T_bollard (s^2 - s (1 - w) u_r / u_0)``, ``s = rpm / n_ref``, floored at 0 (module
+    docstring); ``ur`` is the inflow along the pod's axis (:func:`pod_axial_inflow`), which
+    straight ahead is the relative surge speed.
     """
     s = abs(rpm) * p[P_INV_NREF]
-    return max(p[P_TBOLL] * (s * s - s * ur * p[P_INV_U0]), 0.0)
+    return max(p[P_TBOLL] * (s * s - s * p[P_ADV] * ur * p[P_INV_U0]), 0.0)
+
+
+@row_kernel
+def pod_axial_inflow(x, c, p, k):
+    """Inflow [m/s] along the axis of pod ``k`` (before the wake fraction) for state ``x`` and
+    current ``c``: ``u_p cos alpha + v_p sin alpha`` (module docstring)."""
+    cs = math.cos(x[IPSI])
+    sn = math.sin(x[IPSI])
+    ur = x[IU] - (c[0] * cs + c[1] * sn)
+    vr = x[IV] - (-c[0] * sn + c[1] * cs)
+    a = x[IA1 + k]
+    up = ur - p[P_POD + 2 * k + 1] * x[IR]
+    vp = vr + p[P_POD + 2 * k] * x[IR]
+    return up * math.cos(a) + vp * math.sin(a)
+
+
+@row_kernel
+def pod_thrusts(rpm, x, c, p):
+    """Thrusts [N] of both pods at shaft speed ``rpm``: the propeller law :func:`pod_thrust` at
+    each pod's axial inflow (:func:`pod_axial_inflow`) for state ``x`` and current ``c``."""
+    return (
+        pod_thrust(rpm, pod_axial_inflow(x, c, p, 0), p),
+        pod_thrust(rpm, pod_axial_inflow(x, c, p, 1), p),
+    )
 
 
 @row_kernel
 def _pod_state_rates(x, u, p, out, ur):
     """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
-    tmax = p[P_TBOLL] * min(max(1.0 - ur * p[P_INV_U0], 0.0), 1.0)
+    tmax = p[P_TBOLL] * min(max(1.0 - p[P_ADV] * ur * p[P_INV_U0], 0.0), 1.0)
     amax = p[P_AMAX]
     rate = p[P_ARATE]
     for k in range(2):
@@ -290,18 +407,43 @@ def rvg_row(x, u, p, c, out):
     else:
         ca2 = math.cos(x[IA2])
         sa2 = math.sin(x[IA2])
-    t1 = x[IT1]
-    t2 = x[IT2]
+    t1 = x[IT1] * p[P_HULL_T]  # thrust on the hull, (1 - t) T
+    t2 = x[IT2] * p[P_HULL_T]
     fx = t1 * ca1 + t2 * ca2
     fy = t1 * sa1 + t2 * sa2
     fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (
         -p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2
     )
-    # pod foil lift (module docstring; zero in seed 001)
+    # pod foil normal force from each pod's own inflow (module docstring; zero in seed 001)
     if p[P_LIFT] != 0.0:
-        lift = p[P_LIFT] * ur * abs(ur)
-        fy += lift * (sa1 + sa2)
-        fn += lift * (p[P_POD] * sa1 + p[P_POD + 2] * sa2)
+        for k in range(2):
+            ca = ca1 if k == 0 else ca2
+            sa = sa1 if k == 0 else sa2
+            xt = p[P_POD + 2 * k]
+            yt = p[P_POD + 2 * k + 1]
+            up = ur - yt * r
+            vp = vr + xt * r
+            vv2 = up * up + vp * vp
+            q = vv2 + p[P_SLIP] * max(x[IT1 + k], 0.0)
+            if q > 0.0:
+                if vv2 > 0.0:
+                    vabs = math.sqrt(vv2)
+                    cb = up / vabs
+                    sb = vp / vabs
+                else:
+                    cb = 1.0
+                    sb = 0.0
+                # angle of attack alpha - beta_p, wrapped to [-pi, pi], then stalled
+                aoa = math.atan2(sa * cb - ca * sb, ca * cb + sa * sb)
+                stall = p[P_STALL]
+                if aoa > math.pi - stall:  # flow from astern: the foil works backwards
+                    aoa -= math.pi
+                elif aoa < stall - math.pi:
+                    aoa += math.pi
+                normal = p[P_LIFT] * q * math.sin(min(max(aoa, -stall), stall))
+                fx -= normal * sa
+                fy += normal * ca
+                fn += normal * (xt * ca + yt * sa)
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
     m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
     a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
@@ -315,6 +457,22 @@ def rvg_row(x, u, p, c, out):
     d0 = p[P_DL] * ur + p[P_DL + 1] * vr + p[P_DL + 2] * r + p[P_DQ] * abs(ur) * ur
     d1 = p[P_DL + 3] * ur + p[P_DL + 4] * vr + p[P_DL + 5] * r + p[P_DQ + 1] * abs(vr) * vr
     d2 = p[P_DL + 6] * ur + p[P_DL + 7] * vr + p[P_DL + 8] * r + p[P_DQ + 2] * abs(r) * r
+    # turning speed loss X_vv v^2 + X_vr v r + X_rr r^2 (zero in seed 001)
+    d0 -= p[P_XVV] * vr * vr + p[P_XVR] * vr * r + p[P_XRR] * r * r
+    # sway-yaw cross terms of the cross-flow drag integral (zero in seed 001)
+    if p[P_CF] != 0.0:
+        cf_y = 0.0
+        cf_n = 0.0
+        vq = abs(vr) * vr
+        for j in range(P_CF_W - P_CF_X):
+            xs = p[P_CF_X + j]
+            xr = xs * r
+            s = vr + xr
+            f = (abs(s) * s - vq - abs(xr) * xr) * p[P_CF_W + j]
+            cf_y += f
+            cf_n += f * xs
+        d1 += p[P_CF] * cf_y
+        d2 += p[P_CF] * cf_n
     # eq. (9): nu_c' = [r v_c, -r u_c, 0]; M_a nu_c'
     ncd0 = r * vc
     ncd1 = -r * uc

@@ -57,11 +57,12 @@ lift, no offset, no current):
 effect              definition
 =================== ===========================================================================
 ``thruster_lift``   The pods are foils: the true ship has ``RVGParams(pod_lift_coefficient=
-                    c_L)`` with ``c_L`` [N s^2/m^2] (``POD_LIFT_COEFFICIENT_THRUSTER_DATA``,
-                    about 6.48e3, the value implied by the Kongsberg pod data), i.e. each pod
-                    adds the side force ``L = c_L u_r |u_r| sin(alpha)`` that seed 001 eq.
-                    (19) leaves out. It grows with the square of the speed, unlike the thrust
-                    side force ``T sin(alpha)``.
+                    c_L, pod_slipstream=POD_SLIPSTREAM_FMU)`` with ``c_L`` [N s^2/m^2]
+                    (``POD_LIFT_COEFFICIENT_FMU``, about 5.2e3, the fit to the Kongsberg pod
+                    data), i.e. each pod adds the normal force from its own inflow that seed 001
+                    eq. (19) leaves out (:mod:`shipgym.models.rvg`). It grows with the square
+                    of the speed, unlike the thrust side force ``T sin(alpha)``, and damps sway
+                    and yaw.
 ``azimuth_offset``  The pods' actual azimuth command is the recorded command plus ``alpha_0``
                     [rad] (2 deg) on both pods (an encoder or calibration bias; ``|alpha_0|``
                     below 90 deg). The recorded azimuth does NOT contain the offset; a
@@ -199,7 +200,7 @@ EFFECT_DEFAULTS: dict[str, float] = {
     "input_delay": 3.0,  # tau [s]
     "current": 0.5,  # current speed [m/s]
     "second_order": 7.8,  # T2 [s]
-    "thruster_lift": _rvg.POD_LIFT_COEFFICIENT_THRUSTER_DATA,  # c_L [N s^2/m^2]
+    "thruster_lift": _rvg.POD_LIFT_COEFFICIENT_FMU,  # c_L [N s^2/m^2]
     "azimuth_offset": math.radians(2.0),  # alpha_0 [rad]
     "sway_offset": 0.2,  # v_0 [m/s]
 }
@@ -597,7 +598,7 @@ def _rvg_record(
     effect_params: dict[str, Any] = {}
     if effect == "thruster_lift":
         assert magnitude is not None
-        params = RVGParams(pod_lift_coefficient=magnitude)
+        params = RVGParams(pod_lift_coefficient=magnitude, pod_slipstream=_rvg.POD_SLIPSTREAM_FMU)
         effect_params = {"c_L": magnitude}
     elif effect == "azimuth_offset":
         assert magnitude is not None
@@ -649,7 +650,6 @@ def _rvg_record(
     x0[_rvg.IV] = current[1]
     x0[_rvg.IT1] = x0[_rvg.IT2] = thrust0
 
-    v_n, v_e = float(current[0]), float(current[1])
     azimuths: list[float] = []
     rpms: list[float] = []
 
@@ -658,11 +658,9 @@ def _rvg_record(
         rpm = rpm_cmd(t)
         azimuths.append(azimuth)
         rpms.append(rpm)
-        psi = x[_rvg.IPSI]
-        u_r = x[_rvg.IU] - (v_n * math.cos(psi) + v_e * math.sin(psi))  # seed 001 eq. 8, 10
-        thrust = _rvg.pod_thrust(rpm, u_r, p)
+        t1, t2 = _rvg.pod_thrusts(rpm, x, current, p)  # at each pod's axial inflow
         alpha = azimuth + alpha_0
-        return [thrust, thrust, alpha, alpha]
+        return [t1, t2, alpha, alpha]
 
     sim = model.simulate(x0, controller, h, n_steps=n_fine + 1, current=current)
     idx = np.arange(n_samples) * m
@@ -692,7 +690,7 @@ def _rvg_record(
         "current": current.tolist(),
         "x0": x0.tolist(),
         "steady_relative_surge": u_r0,
-        "rpm_law": "shipgym.models.rvg.pod_thrust(rpm, u_r)",
+        "rpm_law": "shipgym.models.rvg.pod_thrusts(rpm, x, current)",
         "base_model": "rvg3dof",
         "base_params": _rvg_params_dict(base),
         "effect": effect,

@@ -1,0 +1,261 @@
+"""The identification engine: one loop that traces a record's residual to named effects.
+
+For any registered model family (:mod:`shipgym.sysid.families.base`: the Nomoto family,
+seed 000/002/004, and the R/V Gunnerus 3-DOF model, seed 001), :func:`identify`
+
+1. fits the base model on the training part of the record (its first ``1 - holdout``) and
+   scores it on the held-out part;
+2. for each effect of the family's catalogue not yet in the model, fits the augmented model on
+   the training part and scores it on the held-out part;
+3. accepts the best candidate when its held-out BIC drops by more than
+   :data:`~shipgym.sysid.families.base.BIC_MARGIN` **and** its held-out error drops by more than
+   the family's ``min_relative_drop`` (a guard against the strongly correlated simulation
+   residual, which makes the sample count overstate the information); among candidates within
+   :data:`~shipgym.sysid.families.base.TIE_FRACTION` of the best BIC change the one with the
+   fewest parameters wins;
+4. repeats until no candidate is significant or ``max_effects`` are in, then reports the
+   whole-record fits of the base and the final model (:class:`IdentificationResult`).
+
+The held-out BIC of ``n`` samples and per-channel residual sums of squares ``RSS_ch`` is the
+Gaussian (unknown-variance) ``J = sum_ch n log(RSS_ch / n) + k log(n_ch n)`` with ``k`` the
+number of fitted parameters. Every family's specifics (which channels, how a window is replayed,
+the effects' terms) live in its module under :mod:`shipgym.sysid.families`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from shipgym.sysid.data import Record
+from shipgym.sysid.families.base import Candidate, ModelFamily, get_family, jsonable
+
+__all__ = ["IdentificationResult", "identify"]
+
+
+@dataclass
+class IdentificationResult:
+    """Outcome of :func:`identify`.
+
+    Attributes
+    ----------
+    model : str
+        The base model (``"nomoto1"`` ... ``"rvg3dof"``).
+    base, final : object
+        Whole-record fits of the base and final models (the family's fit object:
+        :class:`~shipgym.sysid.fit.FitResult` for the Nomoto family,
+        :class:`~shipgym.sysid.families.rvg.RVGFit` for ``rvg3dof``).
+    effects : list of dict
+        Accepted effects in order: ``{"name", "parameters", "evidence"}``; ``evidence`` holds the
+        held-out scores before/after and the BIC change.
+    diagnostics : dict
+        Residual analysis of the base fit under ``"base"`` and of the final fit under
+        ``"final"``.
+    parameters_before, parameters_after : dict
+        Estimated parameters of the base and final models (the effects' own parameters
+        included).
+    error_before, error_after : dict
+        Simulation error of the base and final models over the whole record: ``psi_rms_deg``,
+        ``r_rms_deg_s`` and, where the record has them, ``xy_rms_m`` and ``u_rms_m_s``. With
+        ``window_s`` the record is cut into consecutive windows, each simulated from the
+        measured state; otherwise one free run from the estimated initial state.
+    window_s : float or None
+        Scoring window [s] (None: whole-record free run).
+    heldout : dict
+        ``from_s`` (start of the held-out part, seconds from the record start),
+        ``error_before`` and ``error_after``: the same errors over the held-out part for the
+        models fitted on the training part only; ``path``: the held-out error after the base
+        and after each accepted effect.
+    traces : dict
+        ``time``, ``split`` (first held-out index), ``window_starts`` (indices) and, per channel,
+        ``{"measured", "before", "after"}`` arrays of the whole-record simulations.
+    rounds : list of dict
+        Every candidate's score per round (for inspection).
+    runtime_s : float
+        Wall time.
+    """
+
+    model: str
+    base: Any
+    final: Any
+    effects: list[dict[str, Any]]
+    diagnostics: dict[str, Any]
+    parameters_before: dict[str, float]
+    parameters_after: dict[str, float]
+    error_before: dict[str, float]
+    error_after: dict[str, float]
+    window_s: float | None = None
+    heldout: dict[str, Any] = field(default_factory=dict)
+    traces: dict[str, Any] = field(default_factory=dict)
+    rounds: list[dict[str, Any]] = field(default_factory=list)
+    runtime_s: float = 0.0
+
+    @property
+    def effect_names(self) -> list[str]:
+        """Names of the accepted effects, in order."""
+        return [e["name"] for e in self.effects]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (the ``shipgym identify --json`` document).
+
+        Keys: ``model``, ``parameters_before``, ``error_before``, ``effects`` (``{name,
+        parameters, evidence}`` in order), ``parameters``, ``error_after``, ``window_s``,
+        ``heldout``, ``rounds``, ``runtime_s``. Non-finite numbers become ``null``.
+        """
+        return jsonable(
+            {
+                "model": self.model,
+                "parameters_before": self.parameters_before,
+                "error_before": self.error_before,
+                "effects": self.effects,
+                "parameters": self.parameters_after,
+                "error_after": self.error_after,
+                "window_s": self.window_s,
+                "heldout": self.heldout,
+                "rounds": self.rounds,
+                "runtime_s": self.runtime_s,
+            }
+        )
+
+
+def identify(
+    record: Record,
+    model: str | ModelFamily = "nomoto1",
+    *,
+    holdout: float = 0.3,
+    max_effects: int = 3,
+    window_s: float | str | None = "auto",
+    progress: Callable[[str], None] | None = None,
+) -> IdentificationResult:
+    """Fit a base model, then add catalogue effects while the held-out score improves.
+
+    Parameters
+    ----------
+    record : Record
+        A manoeuvre record. The Nomoto family needs ``time``, ``delta``, ``psi``, ``r`` (``x``,
+        ``y`` and a speed enable its ``current`` effect); ``rvg3dof`` needs ``rpm``, the
+        azimuth order, positions and speeds, as in the Gunnerus sea trials.
+    model : str or ModelFamily
+        A registered model name (``"nomoto1"``, ``"nomoto2"``, ``"norrbin"``, ``"bech"``,
+        ``"rvg3dof"``) or a family object.
+    holdout : float
+        Fraction of the record (its end) kept out of the fits and used for scoring, in
+        ``[0.1, 0.6]``.
+    max_effects : int
+        Largest number of effects to add (>= 0).
+    window_s : float, "auto" or None
+        Score and report in consecutive windows of this many seconds, each simulated from the
+        measured state (``"auto"``: the family's default); None: one free run.
+    progress : callable, optional
+        Called with a one-line message per fit.
+
+    Returns
+    -------
+    IdentificationResult
+
+    Raises
+    ------
+    ValueError
+        For a bad ``model``, ``holdout``, ``max_effects`` or ``window_s``, or a record too short
+        to split or lacking the channels the model needs.
+    """
+    t_start = time.perf_counter()
+    if not isinstance(record, Record):
+        raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(record).__name__}")
+    family = model if isinstance(model, ModelFamily) else get_family(model)
+    name = model if isinstance(model, str) else family.name
+    if not (
+        isinstance(holdout, int | float)
+        and not isinstance(holdout, bool)
+        and 0.1 <= float(holdout) <= 0.6
+    ):
+        raise ValueError(f"holdout must be a fraction in [0.1, 0.6], got {holdout!r}")
+    if not (isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0):
+        raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
+    t = record.time
+    window = family.resolve_window(window_s, float(t[-1] - t[0]))
+    say = progress or (lambda _msg: None)
+    ctx = family.prepare(record, float(holdout), window)
+
+    t0 = time.perf_counter()
+    base = current = family.fit_base(ctx, say)
+    say(
+        f"base {family.name}: held-out error {current.heldout_error:.4g} "
+        f"({time.perf_counter() - t0:.1f} s)"
+    )
+    path: list[dict[str, Any]] = [{"model": family.name, "heldout_rms": dict(base.heldout_rms)}]
+    effects: list[dict[str, Any]] = []
+    rounds: list[dict[str, Any]] = []
+    while len(effects) < max_effects:
+        scored: dict[str, dict[str, Any]] = {}
+        good: dict[str, tuple[Candidate, float]] = {}
+        for name in family.candidates(current):
+            t0 = time.perf_counter()
+            try:
+                cand = family.try_effect(ctx, current, name)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                say(f"  {name}: fit failed ({exc})")
+                scored[name] = {
+                    "delta_J": math.inf,
+                    "relative_drop": -math.inf,
+                    "significant": False,
+                    "error": str(exc),
+                }
+                continue
+            dj, drop = family.compare(current, cand, name)
+            ok = family.significant(cand, name, dj, drop)
+            scored[name] = {
+                "delta_J": dj,
+                "relative_drop": drop,
+                "significant": ok,
+                "heldout_rms": dict(cand.heldout_rms),
+                **{k: v for k, v in cand.extra.items() if isinstance(v, int | float | str)},
+            }
+            if ok:
+                good[name] = (cand, dj)
+            say(
+                f"  {name}: dJ {dj:.1f}, held-out drop {100 * drop:.1f} %, significant {ok} "
+                f"({time.perf_counter() - t0:.1f} s)"
+            )
+        rounds.append(scored)
+        if not good:
+            break
+        best = family.choose(good)
+        cand = good[best][0]
+        evidence = {
+            "delta_J": scored[best]["delta_J"],
+            "relative_drop": scored[best]["relative_drop"],
+            "heldout_rms_before": dict(current.heldout_rms),
+            "heldout_rms_after": dict(cand.heldout_rms),
+        }
+        evidence.update({k: v for k, v in cand.extra.items() if k.startswith("evidence_")})
+        current = family.accept(ctx, current, cand, best)
+        effects.append(
+            {
+                "name": best,
+                "parameters": family.effect_parameters(current.fitted, best),
+                "evidence": evidence,
+            }
+        )
+        path.append({"model": f"+ {best}", "heldout_rms": dict(current.heldout_rms)})
+        say(f"accepted {best}")
+
+    report = family.finish(ctx, base, current, say)
+    final_params = report.pop("effect_parameters", None)
+    if final_params:
+        for e in effects:
+            e["parameters"] = final_params.get(e["name"], e["parameters"])
+    report["heldout"]["path"] = path
+    return IdentificationResult(
+        model=name,
+        effects=effects,
+        window_s=window,
+        rounds=rounds,
+        runtime_s=time.perf_counter() - t_start,
+        **report,
+    )

@@ -1,0 +1,820 @@
+"""The R/V Gunnerus 3-DOF family: bounded calibration and physical effects (seed 001).
+
+The base model is the RVG 3-DOF model of seed 001 (eq. 5-20, :mod:`shipgym.models.rvg`), driven
+as on the sea trials by the recorded **orders**: the azimuth order of both pods (raw pod sign,
+positive turns to port; the record's ``azimuth``, or ``-delta``) and the rpm order, turned into a
+thrust command at every step by the propeller law at each pod's simulated axial inflow
+(:func:`shipgym.models.rvg.pod_thrusts`). The pods follow both through the model's first-order actuators.
+
+Replay
+------
+A long record of a ship in real sea cannot be replayed in one free run, so the record is cut
+into consecutive windows of ``window_s`` seconds (:data:`RVG_WINDOW_S`); each window starts from
+the measured hull state ``x, y, psi, u, v, r`` (``v = 0`` if not recorded; read off a local fit
+over :data:`START_SMOOTHING_S` around the start, not one noisy sample); the pods' thrust and
+azimuth are not measured, so they run on through the windows from the first orders, and each
+window is simulated by :func:`shipgym.models.integrate.rk4_row` with the record's sample steps
+(:func:`replay_windows`, :func:`simulate_orders` for one free run).
+
+Calibration: the free parameters of the base
+--------------------------------------------
+Only the values seed 001 / RVG_PARAMETERS.md call guesses or judgement are free, each within a
+documented physical range, so that a factor cannot stand in for a missing effect
+(:data:`CALIBRATED`):
+
+=========================== ============== ==========================================================
+``bollard_thrust``           x0.8 .. x1.2   Kongsberg table; the rpm channel is an order (percent
+                                            order x 2.185), not the measured shaft speed
+``surge_quadratic_damping``  x0.5 .. x2     flat-plate guess 1/2 0.125 B T rho
+``sway_linear_damping``      x0.5 .. x2     0.2 x VERES "engineering judgement" (0.1-0.4 x VERES)
+``yaw_linear_damping``       x0.5 .. x2     0.2 x VERES (as sway)
+``sway_quadratic_damping``   x0.5 .. x2     cross-flow drag with C_D 0.5 (Hoerner: 0.25-1.0)
+``yaw_quadratic_damping``    2.87e7..3.65e8 between the cross-flow-consistent D_v L^3 / 32 and the
+                                            source's dimensionally dubious 0.75 D_v L^4 / 64
+=========================== ============== ==========================================================
+
+Effects (:data:`RVG_EFFECTS`, each a documented term of :mod:`shipgym.models.rvg`)
+-------------------------------------------------------------------------------------
+* ``thruster_lift``: foil normal force of each pod from its own inflow with stall and the
+  propeller slipstream (``c_L`` in ``[0, 2e4]`` N s^2/m^2, slipstream fraction ``k_s`` fixed at
+  the Kongsberg pod FMU fit; that fit gives ``c_L`` 5.2e3, its one 34.3 kN point 6.5e3);
+* ``propeller_hull_interaction``: thrust deduction ``t`` in ``[0, 0.3]`` and wake fraction ``w``
+  in ``[0, 0.4]`` (twin-pod ranges, Harvald 1983; MMG eq. 25-28);
+* ``turn_speed_loss``: ``X_vv v^2 + X_vr v r + X_rr r^2`` with prime coefficients
+  ``X'_vv`` in ``[-0.3, 0.1]``, ``X'_vr`` in ``[-0.5, 0.5]``, ``X'_rr`` in ``[-0.1, 0.1]``
+  (``X = rho/2 L T (X'_vv v^2 + X'_vr L v r + X'_rr L^2 r^2)``; MMG hull ranges);
+* ``crossflow_damping``: the sway-yaw cross terms of the cross-flow drag integral, ``C_cf`` in
+  ``[0, 2]`` (2-D cross-flow drag of ship sections, Hoerner 1965);
+* ``azimuth_offset``: the pods' real azimuth is the order plus ``alpha_0`` (``|alpha_0| <= 5``
+  deg: a misaligned azimuth feedback);
+* ``current``: a constant current ``(V_n, V_e)`` in the kinetics (eq. 7-12), ``|V| <= 2`` m/s;
+* ``sway_offset``: the recorded transverse speed is the ship's plus ``v_0`` (``|v_0| <= 1`` m/s:
+  a speed-log or antenna misalignment; the Gunnerus record shows +0.2 m/s on straight runs on
+  every heading).
+
+Fit and criterion
+-----------------
+Weighted least squares (``scipy.optimize.least_squares``) of the windowed simulation error of
+the channels ``psi`` (wrapped), ``r``, ``u``, ``v``, ``x``, ``y``, each divided by its residual
+RMS of a first pass (one reweighting), on the training samples. The engine
+(:mod:`shipgym.sysid.engine`) scores the held-out windows by the Gaussian BIC; the relative-drop
+guard is the geometric mean of the held-out RMS ratios of the motion channels (all but ``v``,
+which a ``sway_offset`` shifts directly), at least :data:`RVG_MIN_RELATIVE_DROP`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import savgol_filter
+
+from shipgym.models import RVGParams
+from shipgym.models._jit import kernel
+from shipgym.models.integrate import RVG3DOF, rk4_row
+from shipgym.models.rvg import (
+    DRAUGHT,
+    IA1,
+    IA2,
+    IT1,
+    IT2,
+    LPP,
+    P_AMAX,
+    POD_SLIPSTREAM_FMU,
+    WATER_DENSITY,
+    YAW_QUADRATIC_DAMPING,
+    YAW_QUADRATIC_DAMPING_CROSSFLOW,
+    pack_rvg,
+    pod_thrusts,
+)
+from shipgym.sysid.data import Record
+from shipgym.sysid.families.base import (
+    Candidate,
+    Effect,
+    ModelFamily,
+    bic,
+    errors,
+    ljung_box,
+    register,
+    window_starts,
+    xcorr,
+)
+
+__all__ = [
+    "CALIBRATED",
+    "RVG_EFFECTS",
+    "RVG_MIN_RELATIVE_DROP",
+    "RVG_WINDOW_S",
+    "FreeParameter",
+    "RVGFamily",
+    "RVGFit",
+    "fit_rvg",
+    "replay_windows",
+    "simulate_orders",
+]
+
+RVG_WINDOW_S = 60.0
+"""Default scoring and fitting window [s] for RVG records."""
+
+START_SMOOTHING_S = 4.0
+"""Span [s] of the local fit that reads each window's starting state (:func:`start_states`)."""
+
+RVG_MIN_RELATIVE_DROP = 0.2
+"""Required drop of the held-out motion RMS (geometric mean) to accept an RVG effect."""
+
+_HALF_RHO_LT = 0.5 * WATER_DENSITY * LPP * DRAUGHT  # prime -> dimensional X_vv [kg/m]
+
+
+@dataclass(frozen=True)
+class FreeParameter:
+    """A fitted quantity: its bounds, how it is scaled for the optimiser and why.
+
+    ``log`` parameters are fitted as ``log(value / seed)`` (``seed`` the seed-001 value); the
+    others as ``value / scale``.
+    """
+
+    name: str
+    low: float
+    high: float
+    seed: float = 0.0
+    scale: float = 1.0
+    log: bool = False
+    reason: str = ""
+
+    def to_theta(self, value: float) -> float:
+        return math.log(value / self.seed) if self.log else value / self.scale
+
+    def from_theta(self, theta: float) -> float:
+        return self.seed * math.exp(theta) if self.log else theta * self.scale
+
+    @property
+    def theta_bounds(self) -> tuple[float, float]:
+        return self.to_theta(self.low), self.to_theta(self.high)
+
+
+_SEED = RVGParams()
+
+
+def _factor(name: str, seed: float, lo: float, hi: float, reason: str) -> FreeParameter:
+    return FreeParameter(name, lo * seed, hi * seed, seed=seed, log=True, reason=reason)
+
+
+CALIBRATED: dict[str, FreeParameter] = {
+    p.name: p
+    for p in (
+        _factor("bollard_thrust", _SEED.bollard_thrust, 0.8, 1.2,
+                "Kongsberg bollard table; the rpm channel is an order, not the shaft speed"),
+        _factor("surge_quadratic_damping", _SEED.surge_quadratic_damping, 0.5, 2.0,
+                "flat-plate guess 1/2 0.125 B T rho"),
+        _factor("sway_linear_damping", float(_SEED.linear_damping[1, 1]), 0.5, 2.0,
+                "0.2 x VERES viscous, engineering judgement"),
+        _factor("yaw_linear_damping", float(_SEED.linear_damping[2, 2]), 0.5, 2.0,
+                "0.2 x VERES viscous, engineering judgement"),
+        _factor("sway_quadratic_damping", _SEED.sway_quadratic_damping, 0.5, 2.0,
+                "cross-flow drag coefficient 0.5 (sections: 0.25-1.0)"),
+        FreeParameter("yaw_quadratic_damping", YAW_QUADRATIC_DAMPING_CROSSFLOW,
+                      YAW_QUADRATIC_DAMPING, seed=YAW_QUADRATIC_DAMPING, log=True,
+                      reason="between D_v L^3/32 (cross-flow) and the source's 3.65e8"),
+    )
+}  # fmt: skip
+"""Free parameters of the base calibration (module docstring)."""
+
+_EFFECT_PARAMETERS: dict[str, FreeParameter] = {
+    p.name: p
+    for p in (
+        FreeParameter("pod_lift_coefficient", 0.0, 2.0e4, scale=1e3,
+                      reason="1/2 rho A dC_L/da of a 2-4 m^2 strut; Kongsberg data: 6.5e3"),
+        FreeParameter("thrust_deduction", 0.0, 0.3, scale=0.1, reason="twin pods: 0.05-0.2"),
+        FreeParameter("wake_fraction", 0.0, 0.4, scale=0.1, reason="twin pods: 0.05-0.3"),
+        FreeParameter("X_vv_prime", -0.3, 0.1, scale=0.1, reason="MMG hulls: -0.15 .. 0"),
+        FreeParameter("X_vr_prime", -0.5, 0.5, scale=0.1, reason="MMG hulls, with m_y"),
+        FreeParameter("X_rr_prime", -0.1, 0.1, scale=0.01, reason="MMG hulls: -0.03 .. 0.03"),
+        FreeParameter("crossflow_coefficient", 0.0, 2.0, scale=0.5,
+                      reason="2-D cross-flow drag of ship sections 0.5-1.5 (Hoerner)"),
+        FreeParameter("alpha_0", -math.radians(5.0), math.radians(5.0), scale=math.radians(1.0),
+                      reason="azimuth feedback misalignment"),
+        FreeParameter("V_n", -2.0, 2.0, scale=0.1, reason="fjord tidal current"),
+        FreeParameter("V_e", -2.0, 2.0, scale=0.1, reason="fjord tidal current"),
+        FreeParameter("v_0", -1.0, 1.0, scale=0.01, reason="log or antenna misalignment"),
+    )
+}  # fmt: skip
+
+RVG_EFFECTS: dict[str, Effect] = {
+    e.name: e
+    for e in (
+        Effect(
+            "thruster_lift",
+            "F_N = c_L (u_p^2 + v_p^2 + k_s 8T/(rho pi D^2)) sin(sat(alpha - beta_p)) per pod, "
+            "normal to the chord",
+            ("pod_lift_coefficient",),
+            {"pod_lift_coefficient": (0.0, 2.0e4)},
+            "seed 001 sec. 5.2 (left out of eq. 19); MMG rudder force, Yasukawa and Yoshimura "
+            "2015 eq. 33-42",
+        ),
+        Effect(
+            "propeller_hull_interaction",
+            "F = (1 - t) T; T = T_b (s^2 - s (1 - w) u_r / u_0)",
+            ("thrust_deduction", "wake_fraction"),
+            {"thrust_deduction": (0.0, 0.3), "wake_fraction": (0.0, 0.4)},
+            "Yasukawa and Yoshimura 2015 eq. 25-28; Harvald 1983",
+        ),
+        Effect(
+            "turn_speed_loss",
+            "X += rho/2 L T (X'_vv v^2 + X'_vr L v r + X'_rr L^2 r^2)",
+            ("X_vv_prime", "X_vr_prime", "X_rr_prime"),
+            {"X_vv_prime": (-0.3, 0.1), "X_vr_prime": (-0.5, 0.5), "X_rr_prime": (-0.1, 0.1)},
+            "Yasukawa and Yoshimura 2015 eq. 9",
+        ),
+        Effect(
+            "crossflow_damping",
+            "Y, N += -rho/2 T C_cf int |v + x r|(v + x r)(1, x) dx less its |v|v, |r|r parts",
+            ("crossflow_coefficient",),
+            {"crossflow_coefficient": (0.0, 2.0)},
+            "Fossen 2011 ch. 6.4 (cross-flow drag principle); Hoerner 1965",
+        ),
+        Effect(
+            "azimuth_offset",
+            "alpha = alpha_order + alpha_0",
+            ("alpha_0",),
+            {"alpha_0": (-math.radians(5.0), math.radians(5.0))},
+            "sensor misalignment",
+        ),
+        Effect(
+            "current",
+            "nu_r = nu - R^T [V_n, V_e, 0]",
+            ("V_n", "V_e"),
+            {"V_n": (-2.0, 2.0), "V_e": (-2.0, 2.0)},
+            "seed 001 eq. 7-12",
+        ),
+        Effect(
+            "sway_offset",
+            "v_recorded = v + v_0",
+            ("v_0",),
+            {"v_0": (-1.0, 1.0)},
+            "speed-log or antenna misalignment",
+        ),
+    )
+}
+"""The effects the loop can add to the ``rvg3dof`` base (module docstring)."""
+
+_CHANNELS = ("psi", "r", "u", "v", "x", "y")
+_MOTION = ("psi", "r", "u", "x", "y")  # the channels of the relative-drop guard
+#: first-pass scales of the channels' residuals [rad, rad/s, m/s, m/s, m, m]
+_FIRST_PASS_SIGMA = (math.radians(2.0), math.radians(0.2), 0.1, 0.1, 5.0, 5.0)
+
+
+def apply_values(base: RVGParams, values: Mapping[str, float]) -> RVGParams:
+    """``base`` with the fitted ship parameters of ``values`` (calibrated and effect
+    parameters; the record-level ``alpha_0``, ``V_n``, ``V_e``, ``v_0`` are ignored)."""
+    kw: dict[str, Any] = {}
+    dl = base.linear_damping.copy()
+    for k, v in values.items():
+        if k == "sway_linear_damping":
+            dl[1, 1] = v
+        elif k == "yaw_linear_damping":
+            dl[2, 2] = v
+        elif k == "X_vv_prime":
+            kw["surge_vv"] = _HALF_RHO_LT * v
+        elif k == "X_vr_prime":
+            kw["surge_vr"] = _HALF_RHO_LT * LPP * v
+        elif k == "X_rr_prime":
+            kw["surge_rr"] = _HALF_RHO_LT * LPP**2 * v
+        elif k == "pod_lift_coefficient":
+            kw[k] = v
+            kw["pod_slipstream"] = POD_SLIPSTREAM_FMU if v > 0 else 0.0
+        elif k in ("alpha_0", "V_n", "V_e", "v_0"):
+            continue
+        else:
+            kw[k] = v
+    return replace(base, linear_damping=dl, **kw)
+
+
+# --------------------------------------------------------------------------------------------
+# windowed replay
+
+
+@kernel
+def _windows_kernel(t, meas, rpm, az, starts, p, c, alpha0, v0, out):  # pragma: no cover - jit
+    n = t.shape[0]
+    m = starts.shape[0]
+    x = np.empty((1, 10))
+    u = np.empty((1, 4))
+    cc = np.empty((1, 2))
+    cc[0, 0] = c[0]
+    cc[0, 1] = c[1]
+    work = np.empty((5, 10))
+    amax = p[P_AMAX]
+    for w in range(m):
+        i0 = starts[w]
+        i1 = starts[w + 1] if w + 1 < m else n
+        for j in range(6):
+            x[0, j] = meas[i0, j]
+        x[0, 4] -= v0
+        if w == 0:  # pods at the first orders; later windows keep the simulated pod states
+            a = min(max(az[i0] + alpha0, -amax), amax)
+            x[0, IA1] = a
+            x[0, IA2] = a
+            x[0, IT1], x[0, IT2] = pod_thrusts(rpm[i0], x[0], c, p)
+        for j in range(10):
+            out[i0, j] = x[0, j]
+        out[i0, 4] += v0
+        for k in range(i0, i1 - 1):
+            u[0, 0], u[0, 1] = pod_thrusts(rpm[k], x[0], c, p)
+            u[0, 2] = az[k] + alpha0
+            u[0, 3] = az[k] + alpha0
+            h = t[k + 1] - t[k]
+            rk4_row(RVG3DOF, x, u, p, cc, h, 0, work[0], work[1], work[2], work[3], work[4])
+            for j in range(10):
+                out[k + 1, j] = x[0, j]
+            out[k + 1, 4] += v0  # the recorded (offset) transverse speed
+
+
+def measured_states(record: Record) -> np.ndarray:
+    """``(n, 6)`` measured ``x, y, psi, u, v, r`` (``v = 0`` where not recorded)."""
+    v = record.v if record.v is not None else np.zeros_like(record.time)
+    return np.column_stack((record.x, record.y, record.psi, record.u, v, record.r))
+
+
+def start_states(record: Record) -> np.ndarray:
+    """Measured hull states for the window starts: :func:`measured_states` smoothed by a
+    quadratic Savitzky-Golay filter over about :data:`START_SMOOTHING_S` seconds.
+
+    A window amplifies the noise of its one starting sample (a 0.02 m/s sway error grows into
+    degrees of heading within a minute), so the start is read off a local fit of the
+    neighbouring samples rather than one sample.
+    """
+    meas = measured_states(record)
+    dt = float(np.median(np.diff(record.time)))
+    w = round(START_SMOOTHING_S / dt) // 2 * 2 + 1
+    if w < 5 or meas.shape[0] < w:
+        return meas
+    meas[:, 2] = np.unwrap(meas[:, 2])
+    return savgol_filter(meas, w, 2, axis=0)
+
+
+def azimuth_orders(record: Record) -> np.ndarray:
+    """The azimuth order [rad] of both pods (raw pod sign: ``azimuth``, or ``-delta``)."""
+    return record.azimuth if record.azimuth is not None else -record.delta
+
+
+def check_record(record: Record) -> None:
+    """``ValueError`` naming the channels an RVG replay needs and the record lacks."""
+    missing = [k for k in ("rpm", "x", "y", "u") if getattr(record, k) is None]
+    if missing:
+        raise ValueError(
+            f"rvg3dof identification needs the record channels rpm, x, y, u (and azimuth or "
+            f"delta); missing: {', '.join(missing)}"
+        )
+
+
+def replay_windows(
+    record: Record,
+    params: RVGParams,
+    starts: np.ndarray,
+    *,
+    alpha_0: float = 0.0,
+    current: tuple[float, float] = (0.0, 0.0),
+    v_0: float = 0.0,
+) -> np.ndarray:
+    """Simulate an RVG record window by window from the measured state.
+
+    Parameters
+    ----------
+    record : Record
+        With ``rpm``, ``x``, ``y``, ``u`` and ``azimuth`` (or ``delta = -azimuth``).
+    params : RVGParams
+        Model parameters.
+    starts : numpy.ndarray
+        Window start indices (increasing, the first 0).
+    alpha_0 : float
+        Azimuth offset [rad] added to the recorded azimuth order.
+    current : tuple of float
+        Constant current ``(V_n, V_e)`` [m/s].
+    v_0 : float
+        Offset [m/s] of the recorded transverse speed.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n, 10)`` simulated states (``rvg.RVG_STATES``), ``v`` as recorded (``+ v_0``).
+    """
+    check_record(record)
+    out = np.empty((record.time.size, 10))
+    _windows_kernel(
+        record.time,
+        start_states(record),
+        record.rpm,
+        azimuth_orders(record),
+        np.asarray(starts, dtype=np.int64),
+        pack_rvg(params),
+        np.asarray(current, dtype=np.float64),
+        float(alpha_0),
+        float(v_0),
+        out,
+    )
+    return out
+
+
+def simulate_orders(
+    params: RVGParams,
+    time: np.ndarray,
+    rpm: np.ndarray,
+    azimuth: np.ndarray,
+    x0: np.ndarray,
+    *,
+    alpha_0: float = 0.0,
+    current: tuple[float, float] = (0.0, 0.0),
+) -> np.ndarray:
+    """One free run of the RVG model driven by rpm and azimuth orders.
+
+    Parameters
+    ----------
+    params : RVGParams
+        Model parameters.
+    time, rpm, azimuth : numpy.ndarray
+        Sample times [s], rpm orders and azimuth orders [rad] (raw pod sign).
+    x0 : numpy.ndarray
+        Initial hull state ``[x, y, psi, u, v, r]`` (``u``, ``v`` over ground).
+    alpha_0 : float
+        Azimuth offset [rad].
+    current : tuple of float
+        Constant current ``(V_n, V_e)`` [m/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n, 6)`` simulated ``x, y, psi, u, v, r`` (``u``, ``v`` over ground).
+    """
+    t = np.asarray(time, dtype=np.float64)
+    n = t.size
+    x0 = np.asarray(x0, dtype=np.float64)
+    if x0.shape != (6,) or not np.all(np.isfinite(x0)):
+        raise ValueError(f"x0 must be 6 finite numbers [x, y, psi, u, v, r], got {x0!r}")
+    meas = np.tile(x0, (n, 1))
+    out = np.empty((n, 10))
+    _windows_kernel(
+        t,
+        meas,
+        np.asarray(rpm, dtype=np.float64),
+        np.asarray(azimuth, dtype=np.float64),
+        np.array([0], dtype=np.int64),
+        pack_rvg(params),
+        np.asarray(current, dtype=np.float64),
+        float(alpha_0),
+        0.0,
+        out,
+    )
+    return out[:, :6]
+
+
+# --------------------------------------------------------------------------------------------
+# fitting
+
+
+@dataclass
+class RVGFit:
+    """A windowed output-error fit of the RVG model.
+
+    Attributes
+    ----------
+    params : RVGParams
+        Fitted ship parameters (calibrated values and effect terms applied).
+    alpha_0 : float
+        Azimuth offset [rad].
+    current : tuple of float
+        ``(V_n, V_e)`` [m/s].
+    v_0 : float
+        Transverse speed offset [m/s] of the record.
+    effects : tuple of str
+        Effects in the model.
+    values, stderr : dict
+        Estimated quantities (the calibrated parameters' values, the effects' parameters) and
+        their standard errors (from the weighted Jacobian; white-residual assumption, so
+        optimistic for correlated simulation errors).
+    at_bound : tuple of str
+        Parameters that ended within 1 % (of the fitted range) of a bound.
+    sigma : tuple of float
+        Channel weights (residual RMS) used.
+    """
+
+    params: RVGParams
+    alpha_0: float = 0.0
+    current: tuple[float, float] = (0.0, 0.0)
+    v_0: float = 0.0
+    effects: tuple[str, ...] = ()
+    values: dict[str, float] = field(default_factory=dict)
+    stderr: dict[str, float] = field(default_factory=dict)
+    at_bound: tuple[str, ...] = ()
+    sigma: tuple[float, ...] = _FIRST_PASS_SIGMA
+
+    def simulate(self, record: Record, starts: np.ndarray) -> np.ndarray:
+        """:func:`replay_windows` with this fit."""
+        return replay_windows(
+            record, self.params, starts, alpha_0=self.alpha_0, current=self.current, v_0=self.v_0
+        )
+
+
+def _residuals(
+    sim: np.ndarray, meas: np.ndarray, mask: np.ndarray, sigma: tuple[float, ...]
+) -> np.ndarray:
+    """Weighted residuals of the channels over the samples in ``mask``."""
+    parts = []
+    # psi, r, u, v, x, y: the same columns in the state and the measured layouts
+    for ch, c in enumerate((2, 5, 3, 4, 0, 1)):
+        e = sim[mask, c] - meas[mask, c]
+        if ch == 0:
+            e = (e + np.pi) % (2.0 * np.pi) - np.pi
+        parts.append(e / sigma[ch])
+    out = np.concatenate(parts)
+    return out if np.all(np.isfinite(out)) else np.full(out.shape, 1e6)
+
+
+def fit_rvg(
+    record: Record,
+    starts: np.ndarray,
+    mask: np.ndarray,
+    effects: tuple[str, ...] = (),
+    init: RVGFit | None = None,
+    *,
+    base: RVGParams | None = None,
+    calibrate: bool = True,
+    max_nfev: int = 60,
+) -> RVGFit:
+    """Windowed output-error fit of the calibrated parameters plus the effects' parameters.
+
+    Parameters
+    ----------
+    record : Record
+        An RVG record (:func:`check_record`).
+    starts : numpy.ndarray
+        Window start indices.
+    mask : numpy.ndarray
+        Boolean mask of the samples the fit may use.
+    effects : tuple of str
+        Effects of :data:`RVG_EFFECTS` in the model.
+    init : RVGFit, optional
+        Warm start (its values and channel weights).
+    base : RVGParams, optional
+        Parameters the fit starts from (seed 001 by default).
+    calibrate : bool
+        Fit the :data:`CALIBRATED` parameters too (else only the effects').
+    max_nfev : int
+        Budget of each of the two passes.
+
+    Returns
+    -------
+    RVGFit
+    """
+    check_record(record)
+    unknown = [e for e in effects if e not in RVG_EFFECTS]
+    if unknown:
+        raise ValueError(f"unknown rvg3dof effects {unknown}; expected {tuple(RVG_EFFECTS)}")
+    base = base or RVGParams()
+    free = [*(CALIBRATED.values() if calibrate else ())]
+    free += [_EFFECT_PARAMETERS[k] for e in effects for k in RVG_EFFECTS[e].parameters]
+    names = [f.name for f in free]
+    theta0 = np.zeros(len(free))
+    for i, f in enumerate(free):
+        if init is not None and f.name in init.values:
+            theta0[i] = f.to_theta(init.values[f.name])
+        elif f.log:
+            theta0[i] = 0.0
+        elif f.name == "pod_lift_coefficient":
+            theta0[i] = f.to_theta(0.5 * f.high)
+        else:
+            theta0[i] = f.to_theta(min(max(0.0, f.low), f.high))
+    lo = np.array([f.theta_bounds[0] for f in free])
+    hi = np.array([f.theta_bounds[1] for f in free])
+    span = hi - lo
+    theta0 = np.clip(theta0, lo + 1e-6 * span, hi - 1e-6 * span)
+    meas = measured_states(record)
+    start = start_states(record)
+    az = azimuth_orders(record)
+    out = np.empty((record.time.size, 10))
+    starts64 = np.asarray(starts, dtype=np.int64)
+    has_v = record.v is not None
+
+    def unpack(th: np.ndarray) -> dict[str, float]:
+        return {f.name: f.from_theta(float(v)) for f, v in zip(free, th, strict=True)}
+
+    def simulate(th: np.ndarray) -> np.ndarray:
+        vals = unpack(th)
+        _windows_kernel(
+            record.time, start, record.rpm, az, starts64, pack_rvg(apply_values(base, vals)),
+            np.array([vals.get("V_n", 0.0), vals.get("V_e", 0.0)]), vals.get("alpha_0", 0.0),
+            vals.get("v_0", 0.0), out,
+        )  # fmt: skip
+        return out
+
+    sigma = list(init.sigma if init is not None else _FIRST_PASS_SIGMA)
+    if not has_v:
+        sigma[3] = math.inf
+    sol = None
+    for _ in range(2):  # first pass, then reweighted by the channels' residual RMS
+        sig = tuple(sigma)
+        with np.errstate(all="ignore"):
+            sol = least_squares(
+                lambda th, s=sig: _residuals(simulate(th), meas, mask, s),
+                theta0,
+                bounds=(lo, hi),
+                x_scale=1.0,
+                max_nfev=max_nfev,
+            )
+        theta0 = sol.x
+        sim = simulate(sol.x)
+        for ch, r in enumerate(_residuals(sim, meas, mask, (1.0,) * 6).reshape(6, -1)):
+            if ch == 3 and not has_v:
+                continue
+            sigma[ch] = max(float(np.sqrt(np.mean(r**2))), 1e-9)
+    if sol is None:  # pragma: no cover - the loop runs twice
+        raise RuntimeError("no fit")
+    values = unpack(sol.x)
+    stderr: dict[str, float] = {}
+    try:
+        J = sol.jac
+        dof = max(J.shape[0] - J.shape[1], 1)
+        cov = np.linalg.pinv(J.T @ J) * (2.0 * sol.cost / dof)
+        for i, f in enumerate(free):
+            d = math.sqrt(max(cov[i, i], 0.0))
+            stderr[f.name] = values[f.name] * d if f.log else d * f.scale
+    except (np.linalg.LinAlgError, ValueError):
+        pass
+    at_bound = tuple(
+        n for n, th, a, b in zip(names, sol.x, lo, hi, strict=True)
+        if min(th - a, b - th) < 0.01 * (b - a)
+    )  # fmt: skip
+    return RVGFit(
+        params=apply_values(base, values),
+        alpha_0=values.get("alpha_0", 0.0),
+        current=(values.get("V_n", 0.0), values.get("V_e", 0.0)),
+        v_0=values.get("v_0", 0.0),
+        effects=tuple(effects),
+        values=values,
+        stderr=stderr,
+        at_bound=at_bound,
+        sigma=tuple(sigma),
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# the family
+
+
+_REPORTED = (("psi", 2), ("r", 5), ("x", 0), ("y", 1), ("u", 3))  # channel, state column
+
+
+def _channels(sim: np.ndarray) -> dict[str, np.ndarray]:
+    """The reported channels of an ``(n, 10)`` RVG simulation."""
+    return {ch: sim[:, col] for ch, col in _REPORTED}
+
+
+@dataclass
+class _Context:
+    record: Record
+    starts: np.ndarray
+    split: int
+    train: np.ndarray
+    held: np.ndarray
+    every: np.ndarray
+    has_v: bool
+
+
+class RVGFamily(ModelFamily):
+    """The R/V Gunnerus 3-DOF model as an identification family (module docstring)."""
+
+    name = "rvg3dof"
+    catalogue = RVG_EFFECTS
+    min_relative_drop = RVG_MIN_RELATIVE_DROP
+    default_window_s = RVG_WINDOW_S
+
+    def prepare(self, record: Record, holdout: float, window_s: float | None) -> _Context:
+        check_record(record)
+        window = RVG_WINDOW_S if window_s is None else window_s
+        t = record.time
+        starts = window_starts(t, window)
+        n_train = round(starts.size * (1.0 - holdout))
+        if n_train < 2 or starts.size - n_train < 1:
+            raise ValueError(
+                f"record too short for windowed RVG identification: {starts.size} windows of "
+                f"{window:g} s (need >= 3; use a shorter window_s)"
+            )
+        split = int(starts[n_train])
+        train = np.zeros(t.size, dtype=bool)
+        train[:split] = True
+        held = ~train
+        first = np.zeros(t.size, dtype=bool)
+        first[starts] = True  # the first sample of a window is the measurement itself
+        return _Context(
+            record, starts, split, train & ~first, held & ~first, ~first, record.v is not None
+        )
+
+    def _score(self, ctx: _Context, fit: RVGFit) -> Candidate:
+        sim = fit.simulate(ctx.record, ctx.starts)
+        mask = ctx.held
+        n = int(mask.sum())
+        if not np.all(np.isfinite(sim[mask])):
+            return Candidate(fit.effects, fit, math.inf, math.inf)
+        e = _residuals(sim, measured_states(ctx.record), mask, (1.0,) * 6).reshape(6, -1)
+        rss = {
+            ch: float(r @ r) for ch, r in zip(_CHANNELS, e, strict=True) if ch != "v" or ctx.has_v
+        }
+        rms = {k: math.sqrt(v / n) for k, v in rss.items()}
+        # geometric mean of the motion channels' RMS: the relative-drop guard
+        err = math.exp(float(np.mean([math.log(max(rms[k], 1e-300)) for k in _MOTION])))
+        return Candidate(fit.effects, fit, bic(rss, n, len(fit.values)), err, rms)
+
+    def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
+        fit = fit_rvg(ctx.record, ctx.starts, ctx.train)
+        if fit.at_bound:
+            say(f"  base calibration at a bound: {', '.join(fit.at_bound)}")
+        return self._score(ctx, fit)
+
+    def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
+        fit = fit_rvg(
+            ctx.record, ctx.starts, ctx.train, (*current.effects, name), current.fitted
+        )
+        return self._score(ctx, fit)
+
+    def effect_parameters(self, fitted: RVGFit, name: str) -> dict[str, float]:
+        out = {k: fitted.values[k] for k in RVG_EFFECTS[name].parameters}
+        if name == "azimuth_offset":
+            out["alpha_0_deg"] = math.degrees(out["alpha_0"])
+        elif name == "current":
+            out["speed"] = math.hypot(out["V_n"], out["V_e"])
+            out["direction"] = math.atan2(out["V_e"], out["V_n"]) % (2.0 * math.pi)
+        elif name == "turn_speed_loss":
+            p = fitted.params
+            out.update(X_vv=p.surge_vv, X_vr=p.surge_vr, X_rr=p.surge_rr)
+        elif name == "thruster_lift":
+            out["pod_slipstream"] = fitted.params.pod_slipstream
+        return out
+
+    def finish(
+        self, ctx: _Context, base: Candidate, final: Candidate, say: Callable[[str], None]
+    ) -> dict[str, Any]:
+        rec, starts = ctx.record, ctx.starts
+        seed = RVGFit(RVGParams())
+        held_idx = np.flatnonzero(ctx.held)
+        heldout = {
+            "from_s": float(rec.time[ctx.split] - rec.time[0]),
+            "error_seed001": errors(rec, _channels(seed.simulate(rec, starts)), held_idx),
+            "error_before": errors(rec, _channels(base.fitted.simulate(rec, starts)), held_idx),
+            "error_after": errors(rec, _channels(final.fitted.simulate(rec, starts)), held_idx),
+        }
+        say("whole-record fits of the base and final models")
+        base_full = fit_rvg(rec, starts, ctx.every, (), base.fitted)
+        final_full = (
+            fit_rvg(rec, starts, ctx.every, final.effects, final.fitted)
+            if final.effects
+            else base_full
+        )
+        sim_seed = seed.simulate(rec, starts)
+        sim_before = base_full.simulate(rec, starts)
+        sim_after = final_full.simulate(rec, starts)
+        every_idx = np.flatnonzero(ctx.every)
+        resid_r = rec.r - sim_after[:, 5]
+        az = azimuth_orders(rec)
+        diagnostics = {
+            "seed001": {"error": errors(rec, _channels(sim_seed), every_idx)},
+            "base": {
+                "stderr": base_full.stderr,
+                "sigma": base_full.sigma,
+                "at_bound": list(base_full.at_bound),
+            },
+            "final": {
+                "stderr": final_full.stderr,
+                "sigma": final_full.sigma,
+                "at_bound": list(final_full.at_bound),
+                "ljung_box": ljung_box(resid_r[ctx.every], 20),
+                "xcorr_azimuth": {lag: xcorr(resid_r, az, lag) for lag in (0, 4, 20)},
+            },
+        }
+        traces: dict[str, Any] = {"time": rec.time, "split": ctx.split, "window_starts": starts}
+        for ch, col in _REPORTED:
+            traces[ch] = {
+                "measured": getattr(rec, ch),
+                "before": sim_before[:, col],
+                "after": sim_after[:, col],
+                "seed001": sim_seed[:, col],
+            }
+        return {
+            "base": base_full,
+            "final": final_full,
+            "diagnostics": diagnostics,
+            "parameters_before": dict(base_full.values),
+            "parameters_after": dict(final_full.values),
+            "error_before": errors(rec, _channels(sim_before), every_idx),
+            "error_after": errors(rec, _channels(sim_after), every_idx),
+            "heldout": heldout,
+            "traces": traces,
+            "effect_parameters": {
+                e: self.effect_parameters(final_full, e) for e in final_full.effects
+            },
+        }
+
+
+register(RVGFamily())
