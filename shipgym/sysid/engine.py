@@ -25,8 +25,10 @@ the effects' terms) live in its module under :mod:`shipgym.sysid.families`.
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -123,6 +125,14 @@ class IdentificationResult:
         )
 
 
+def _try(family: ModelFamily, ctx: Any, current: Candidate, name: str) -> Candidate | Exception:
+    """``family.try_effect``, with a failed fit returned as its exception."""
+    try:
+        return family.try_effect(ctx, current, name)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        return exc
+
+
 def identify(
     record: Record,
     model: str | ModelFamily = "nomoto1",
@@ -175,7 +185,9 @@ def identify(
         and 0.1 <= float(holdout) <= 0.6
     ):
         raise ValueError(f"holdout must be a fraction in [0.1, 0.6], got {holdout!r}")
-    if not (isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0):
+    if not (
+        isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0
+    ):
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
     t = record.time
     window = family.resolve_window(window_s, float(t[-1] - t[0]))
@@ -194,17 +206,21 @@ def identify(
     while len(effects) < max_effects:
         scored: dict[str, dict[str, Any]] = {}
         good: dict[str, tuple[Candidate, float]] = {}
-        for name in family.candidates(current):
-            t0 = time.perf_counter()
-            try:
-                cand = family.try_effect(ctx, current, name)
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                say(f"  {name}: fit failed ({exc})")
+        names = list(family.candidates(current))
+        t0 = time.perf_counter()
+        if family.concurrent_candidates and len(names) > 1:
+            with ThreadPoolExecutor(max_workers=min(len(names), os.cpu_count() or 1)) as pool:
+                outcomes = list(pool.map(lambda n, c=current: _try(family, ctx, c, n), names))
+        else:
+            outcomes = [_try(family, ctx, current, n) for n in names]
+        for name, cand in zip(names, outcomes, strict=True):
+            if isinstance(cand, Exception):
+                say(f"  {name}: fit failed ({cand})")
                 scored[name] = {
                     "delta_J": math.inf,
                     "relative_drop": -math.inf,
                     "significant": False,
-                    "error": str(exc),
+                    "error": str(cand),
                 }
                 continue
             dj, drop = family.compare(current, cand, name)
@@ -218,10 +234,8 @@ def identify(
             }
             if ok:
                 good[name] = (cand, dj)
-            say(
-                f"  {name}: dJ {dj:.1f}, held-out drop {100 * drop:.1f} %, significant {ok} "
-                f"({time.perf_counter() - t0:.1f} s)"
-            )
+            say(f"  {name}: dJ {dj:.1f}, held-out drop {100 * drop:.1f} %, significant {ok}")
+        say(f"  ({len(names)} candidates in {time.perf_counter() - t0:.1f} s)")
         rounds.append(scored)
         if not good:
             break

@@ -129,6 +129,8 @@ class ModelFamily(ABC):
     min_relative_drop: float = 0.2
     #: Default scoring window [s] (None: one free run over the record).
     default_window_s: float | None = None
+    #: True when ``try_effect`` calls share no state, so the engine may run them in threads.
+    concurrent_candidates: bool = False
 
     def resolve_window(self, window_s: float | str | None, duration: float) -> float | None:
         """The scoring window [s] for ``window_s`` (``"auto"``: :attr:`default_window_s`)."""
