@@ -453,11 +453,11 @@ def test_rvg_turning_speed_loss_and_crossflow_cross_terms() -> None:
 
         k = -0.5 * WATER_DENSITY * DRAUGHT * 0.8
 
-        def cross(xx: float, v: float = v, r: float = r) -> float:
+        def integrand(xx: float, v: float = v, r: float = r) -> float:
             return g(v + xx * r) - g(v) - g(xx * r)
 
-        y = k * quad(cross, xa, xf, limit=200)[0]
-        n = k * quad(lambda xx: xx * cross(xx), xa, xf, limit=200)[0]
+        y = k * quad(integrand, xa, xf, limit=200)[0]
+        n = k * quad(lambda xx: xx * integrand(xx), xa, xf, limit=200)[0]
         np.testing.assert_allclose(f[1:], [y, n], rtol=1e-2, atol=1.0)  # 12-point quadrature
     for v, r in ((0.7, 0.0), (0.0, 0.05)):
         x = np.array([0.0, 0.0, 0.0, 4.0, v, r, 0.0, 0.0, 0.0, 0.0])
