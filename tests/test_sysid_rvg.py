@@ -1,4 +1,4 @@
-"""Tests of the RVG 3-DOF calibration and effect loop (shipgym.sysid.rvg_identify).
+"""Tests of the R/V Gunnerus family of the identification engine (shipgym.sysid.families.rvg).
 
 Known truth from the project's generator (seed-001 Gunnerus ship with one undeclared effect,
 sensor noise, random azimuth and rpm orders): the right effect is named, its parameter is
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from shipgym.models import RVGParams
-from shipgym.models.rvg import POD_LIFT_COEFFICIENT_THRUSTER_DATA
-from shipgym.sysid.effects import identify
+from shipgym.models.rvg import POD_LIFT_COEFFICIENT_FMU, POD_SLIPSTREAM_FMU
+from shipgym.sysid import identify
+from shipgym.sysid.families.rvg import CALIBRATED, replay_windows
 from shipgym.sysid.generator import generate_record
-from shipgym.sysid.rvg_identify import CALIBRATED, replay_windows
 
 
 def _rvg(effect: str | None, seed: int = 2, maneuver: str = "random"):
@@ -41,7 +41,7 @@ def test_clean_rvg_record_gets_no_effect_and_calibration_near_seed001(seed: int)
 @pytest.mark.parametrize(
     ("effect", "key", "truth", "tol"),
     [
-        ("thruster_lift", "pod_lift_coefficient", POD_LIFT_COEFFICIENT_THRUSTER_DATA, 0.15),
+        ("thruster_lift", "pod_lift_coefficient", POD_LIFT_COEFFICIENT_FMU, 0.15),
         ("azimuth_offset", "alpha_0", math.radians(2.0), 0.15),
         ("current", "speed", 0.5, 0.15),
         ("sway_offset", "v_0", 0.2, 0.15),
@@ -83,8 +83,11 @@ def test_replay_windows_restart_from_the_measured_state() -> None:
         sim = replay_windows(clean, params, starts)
         return math.degrees(float(np.sqrt(np.mean((sim[120:, 2] - clean.psi[120:]) ** 2))))
 
-    assert rms_psi_deg(RVGParams()) < 1.0
-    assert rms_psi_deg(RVGParams(pod_lift_coefficient=6000.0)) > 20.0
+    # (2.5 deg, not less: the pods' thrust follows their axial inflow, which the unstable sway-yaw
+    # mode of the seed-001 hull moves within a 0.5 s hold)
+    assert rms_psi_deg(RVGParams()) < 3.0
+    lift = RVGParams(pod_lift_coefficient=5000.0, pod_slipstream=POD_SLIPSTREAM_FMU)
+    assert rms_psi_deg(lift) > 5.0
 
 
 def test_rvg_identification_rejects_records_without_rpm_or_positions() -> None:

@@ -178,7 +178,7 @@ def identify(
     if not isinstance(record, Record):
         raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(record).__name__}")
     family = model if isinstance(model, ModelFamily) else get_family(model)
-    name = model if isinstance(model, str) else family.name
+    model_name = model if isinstance(model, str) else family.name
     if not (
         isinstance(holdout, int | float)
         and not isinstance(holdout, bool)
@@ -241,14 +241,15 @@ def identify(
             break
         best = family.choose(good)
         cand = good[best][0]
+        before = dict(current.heldout_rms)
+        current = family.accept(ctx, current, cand, best)
         evidence = {
             "delta_J": scored[best]["delta_J"],
             "relative_drop": scored[best]["relative_drop"],
-            "heldout_rms_before": dict(current.heldout_rms),
-            "heldout_rms_after": dict(cand.heldout_rms),
+            "heldout_rms_before": before,
+            "heldout_rms_after": dict(current.heldout_rms),
         }
         evidence.update({k: v for k, v in cand.extra.items() if k.startswith("evidence_")})
-        current = family.accept(ctx, current, cand, best)
         effects.append(
             {
                 "name": best,
@@ -266,7 +267,7 @@ def identify(
             e["parameters"] = final_params.get(e["name"], e["parameters"])
     report["heldout"]["path"] = path
     return IdentificationResult(
-        model=name,
+        model=model_name,
         effects=effects,
         window_s=window,
         rounds=rounds,
