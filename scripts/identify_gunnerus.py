@@ -1,0 +1,233 @@
+"""Identify R/V Gunnerus from its sea trials and validate the model manoeuvre by manoeuvre.
+
+Usage::
+
+    python scripts/identify_gunnerus.py [--record PATH] [--out docs] [--folds 3]
+                                        [--readme README.md | --no-readme]
+
+1. Runs the identification loop (:func:`shipgym.sysid.identify`, ``rvg3dof``) from the seed-001
+   base on the sea-trial record and draws its path: the held-out error after the base and after
+   each accepted effect (``OUT/gunnerus_loop.png``).
+2. Extracts the manoeuvres of the record (:mod:`shipgym.sysid.manoeuvres`: straight runs per
+   rpm, steady turns per azimuth, zigzag-like sequences) and cross-validates by manoeuvre: the
+   manoeuvres are split into ``--folds`` groups; for each group the loop's final model is fitted
+   on the record without that group's manoeuvres and predicts them. The table puts the
+   measurement, the seed-001 model, the cross-validated model and the shipped sea-trial set
+   (:meth:`shipgym.models.RVGParams.sea_trials`, fitted on the whole record) side by side
+   (``OUT/gunnerus_manoeuvres.png``).
+3. Writes ``OUT/gunnerus.json`` and ``OUT/gunnerus.md`` and the README block between
+   ``<!-- gunnerus -->`` and ``<!-- /gunnerus -->``, and prints the whole-record ship
+   parameters (the values of ``SEA_TRIALS_VALUES`` in :mod:`shipgym.models.rvg`).
+
+The data stay where they are; nothing is copied.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from shipgym.models import RVGParams
+from shipgym.models.rvg import SEA_TRIALS_VALUES
+from shipgym.sysid import identify, load
+from shipgym.sysid import manoeuvres as mn
+from shipgym.sysid.families.base import jsonable, window_starts
+from shipgym.sysid.families.rvg import (
+    CALIBRATED,
+    RVG_WINDOW_S,
+    RVGFit,
+    fit_rvg,
+    measured_states,
+    simulate_orders,
+)
+from shipgym.sysid.report import update_readme
+
+REPO = Path(__file__).resolve().parents[1]
+DEFAULT_RECORD = (
+    REPO / ".." / "shared" / "data" / "measured" / "gunnerus_seatrials" / "RVG_ManeuveringTests.csv"
+).resolve()
+_LOOP_CHANNELS = (("psi", "heading [deg]", math.degrees), ("r", "yaw rate [deg/s]", math.degrees),
+                  ("u", "surge speed [m/s]", float), ("x", "north [m]", float))  # fmt: skip
+
+
+def _simulator(params: RVGParams):
+    def simulate(t: np.ndarray, rpm: np.ndarray, az: np.ndarray, x0: np.ndarray) -> np.ndarray:
+        return simulate_orders(params, t, rpm, az, x0)
+
+    return simulate
+
+
+def plot_loop(path: list[dict[str, Any]], seed: dict[str, float], out: Path) -> None:
+    """Held-out RMS per channel after the base and each accepted effect."""
+    fig, axes = plt.subplots(1, len(_LOOP_CHANNELS), figsize=(13, 3.6))
+    labels = ["seed 001", *(p["model"] for p in path)]
+    for ax, (ch, name, conv) in zip(axes, _LOOP_CHANNELS, strict=True):
+        vals = [conv(seed[ch]), *(conv(p["heldout_rms"][ch]) for p in path)]
+        ax.bar(range(len(vals)), vals, color=["0.6", *(["C0"] * len(path))])
+        ax.set_xticks(range(len(vals)), labels, rotation=30, ha="right", fontsize=8)
+        ax.set_title(f"held-out RMS, {name}", fontsize=9)
+        ax.grid(axis="y", alpha=0.3)
+    fig.suptitle("Gunnerus sea trials: the identification loop's path (60 s windows, last 30 %)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+#: (kind, error key, label, target, unit): the targets on manoeuvres not used for fitting
+TARGETS = (
+    ("straight", "speed_pct", "straight speed", 3.0, "%"),
+    ("turn", "yaw_rate_pct", "steady yaw rate", 10.0, "%"),
+    ("turn", "diameter_pct", "turning diameter", 15.0, "%"),
+    ("turn", "speed_ratio_abs", "speed ratio in the turn", 0.05, ""),
+    ("zigzag", "overshoot_mean_deg", "zigzag overshoot (mean)", 2.0, "deg"),
+    ("zigzag", "overshoot_max_deg", "zigzag overshoot (max)", 2.0, "deg"),
+)
+
+
+def summarise(rows: list[dict[str, Any]], models: tuple[str, ...]) -> tuple[list, str]:
+    """Worst and median absolute error per quantity and model, against :data:`TARGETS`."""
+    out = []
+    lines = [
+        "| quantity | target | " + " | ".join(f"{m}: median / worst" for m in models) + " |",
+        "|---|---|" + "---|" * len(models),
+    ]
+    for kind, key, label, target, unit in TARGETS:
+        cells = []
+        entry: dict[str, Any] = {"quantity": label, "target": target, "unit": unit}
+        for m in models:
+            e = np.array([abs(r["errors"][m][key]) for r in rows if r["kind"] == kind])
+            e = np.where(np.isfinite(e), e, np.inf)
+            n_ok = int(np.sum(e <= target))
+            entry[m] = {"median": float(np.median(e)), "worst": float(e.max()), "met": n_ok,
+                        "of": int(e.size)}  # fmt: skip
+            cells.append(f"{np.median(e):.3g} / {e.max():.3g} {unit} ({n_ok}/{e.size} met)")
+        out.append(entry)
+        lines.append(f"| {label} | {target:g} {unit} | " + " | ".join(cells) + " |")
+    return out, "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--record", default=str(DEFAULT_RECORD), help="the sea-trial CSV")
+    ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
+    ap.add_argument("--folds", type=int, default=3, help="cross-validation folds (>= 2)")
+    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
+    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    args = ap.parse_args(argv)
+    if args.folds < 2:
+        ap.error(f"--folds must be >= 2, got {args.folds}")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    def say(msg: str) -> None:
+        print(msg, file=sys.stderr, flush=True)
+
+    t0 = time.perf_counter()
+    rec = load(args.record)
+    res = identify(rec, "rvg3dof", progress=lambda m: say(f"  {m}"))
+    loop_s = time.perf_counter() - t0
+    say(f"loop: {res.effect_names} in {loop_s:.1f} s")
+    ctx_starts = window_starts(rec.time, RVG_WINDOW_S)
+    held = rec.time >= rec.time[0] + res.heldout["from_s"]
+    seed_sim = RVGFit(RVGParams()).simulate(rec, ctx_starts)
+    meas = measured_states(rec)
+    seed_rms = {}
+    for ch, col in (("psi", 2), ("r", 5), ("u", 3), ("x", 0)):
+        e = seed_sim[held, col] - meas[held, col]
+        if ch == "psi":
+            e = (e + np.pi) % (2 * np.pi) - np.pi
+        seed_rms[ch] = float(np.sqrt(np.mean(e**2)))
+    plot_loop(res.heldout["path"], seed_rms, out / "gunnerus_loop.png")
+
+    # cross-validation by manoeuvre
+    ms = mn.extract_manoeuvres(rec)
+    say(f"{len(ms)} manoeuvres; {args.folds}-fold cross-validation by manoeuvre")
+    first = np.zeros(rec.time.size, dtype=bool)
+    first[ctx_starts] = True
+    rows: list[dict[str, Any]] = []
+    fold_params = []
+    for k, (group, mask) in enumerate(mn.folds(ms, args.folds)):
+        fit = fit_rvg(rec, ctx_starts, mask & ~first, tuple(res.final.effects), res.final)
+        fold_params.append(
+            {n: fit.values[n] for n in (*CALIBRATED, *fit.values) if n in fit.values}
+        )
+        say(f"  fold {k + 1}: {len(group)} manoeuvres held out; bounds hit: {fit.at_bound}")
+        models = {
+            "seed 001": _simulator(RVGParams()),
+            "identified (cross-validated)": _simulator(fit.params),
+            "sea_trials set": _simulator(RVGParams.sea_trials()),
+        }
+        for row in mn.validation_table(group, rec, models):
+            row["fold"] = k + 1
+            rows.append(row)
+    rows.sort(key=lambda r: r["t_start"])
+    mn.plot_validation(rows, out / "gunnerus_manoeuvres.png")
+    table = mn.render_markdown(rows)
+    summary, summary_md = summarise(rows, ("seed 001", "identified (cross-validated)"))
+
+    final = res.final
+    values = {k: v for k, v in final.values.items() if k not in ("alpha_0", "V_n", "V_e", "v_0")}
+    doc = {
+        "record": str(args.record),
+        "loop_runtime_s": loop_s,
+        "identification": res.to_dict(),
+        "heldout_seed001": seed_rms,
+        "at_bound": list(final.at_bound),
+        "sea_trials_values": values,
+        "shipped_sea_trials_values": SEA_TRIALS_VALUES,
+        "folds": fold_params,
+        "targets": summary,
+        "manoeuvres": rows,
+    }
+    (out / "gunnerus.json").write_text(json.dumps(jsonable(doc), indent=1) + "\n")
+    held_err = res.heldout
+    lines = [
+        "Loop from the seed-001 base (60 s windows from the measured state, last 30 % held "
+        f"out; `python scripts/identify_gunnerus.py`, {loop_s:.0f} s): effects named "
+        + (", ".join(f"`{e}`" for e in res.effect_names) or "none")
+        + ".",
+        "",
+        "| held-out error | seed 001 | calibrated base | identified |",
+        "|---|---|---|---|",
+    ]
+    shown = (("psi_rms_deg", "heading RMS [deg]"), ("r_rms_deg_s", "yaw rate RMS [deg/s]"),
+             ("u_rms_m_s", "speed RMS [m/s]"), ("xy_rms_m", "position RMS [m]"))  # fmt: skip
+    for key, name in shown:
+        a, b, c = (held_err[k][key] for k in ("error_seed001", "error_before", "error_after"))
+        lines.append(f"| {name} | {a:.2f} | {b:.2f} | {c:.2f} |")
+    lines += ["", f"{len(ms)} manoeuvres extracted from the record, cross-validated by manoeuvre "
+              f"({args.folds} folds: each is predicted by the final model fitted on the record "
+              "without it): absolute errors against the targets.", "", summary_md, "",
+              "![loop](docs/gunnerus_loop.png)", "",
+              "![manoeuvres](docs/gunnerus_manoeuvres.png)"]  # fmt: skip
+    block = "\n".join(lines)
+    doc_md = block.replace("docs/", "") + "\n\n## Every manoeuvre\n\n" + table + "\n"
+    (out / "gunnerus.md").write_text("# R/V Gunnerus: identification and validation\n\n" + doc_md)
+    if not args.no_readme:
+        update_readme(
+            args.readme,
+            block + "\n\nEvery manoeuvre: [docs/gunnerus.md](docs/gunnerus.md).",
+            "gunnerus",
+        )
+    print(block)
+    print("\nwhole-record ship parameters (SEA_TRIALS_VALUES):")
+    for k, v in values.items():
+        print(f"    {k!r}: {v:.5g},")
+    if final.at_bound:
+        print(f"at a bound: {', '.join(final.at_bound)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
