@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from shipgym.sysid.data import Record
-from shipgym.sysid.effects import IdentificationResult
+from shipgym.sysid.engine import IdentificationResult
 from shipgym.sysid.report import (
     DEFAULT_MODELS,
     FIGURES,

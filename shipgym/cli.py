@@ -247,7 +247,7 @@ def _simulate_zigzag(args: argparse.Namespace) -> _Trial:
 
     a = 20.0 if args.angle_deg is None else args.angle_deg
     n = 4 if args.reversals is None else args.reversals
-    res = mv.zigzag(args.model, a, args.heading_deg, args.side or "starboard", n, dt=args.dt)
+    res = mv.zigzag(args.ship, a, args.heading_deg, args.side or "starboard", n, dt=args.dt)
     over = ", ".join("not checked" if math.isnan(o) else f"{o:.2f}" for o in res.overshoots_deg)
     print(
         f"zigzag {res.label} ({res.first} first): {res.particulars.vessel} ({res.model}), "
@@ -270,7 +270,7 @@ def _simulate_turning(args: argparse.Namespace) -> _Trial:
     from shipgym import maneuvers as mv
 
     a = 35.0 if args.angle_deg is None else args.angle_deg
-    res = mv.turning_circle(args.model, a, args.side or "starboard", dt=args.dt)
+    res = mv.turning_circle(args.ship, a, args.side or "starboard", dt=args.dt)
     L = res.particulars.length
     print(
         f"turning circle {math.degrees(res.rudder):g} deg to {res.side}: "
@@ -299,7 +299,7 @@ def _simulate_pullout(args: argparse.Namespace) -> _Trial:
     from shipgym import maneuvers as mv
 
     a = 20.0 if args.angle_deg is None else args.angle_deg
-    res = mv.pullout(args.model, a, args.side or "starboard", dt=args.dt)
+    res = mv.pullout(args.ship, a, args.side or "starboard", dt=args.dt)
     print(
         f"pull-out after {math.degrees(res.rudder):g} deg to {res.side}: "
         f"{res.particulars.vessel} ({res.model})"
@@ -327,7 +327,7 @@ def _simulate_spiral(args: argparse.Namespace) -> _Trial:
         leg = [args.angle_deg * f for f in fractions]
         rudders = [*leg, 0.0, *(-d for d in reversed(leg))]
     kinds = ("direct", "reverse") if args.kind in (None, "both") else (args.kind,)
-    results = [mv.spiral(args.model, rudders, k, dt=args.dt, progress=_progress) for k in kinds]
+    results = [mv.spiral(args.ship, rudders, k, dt=args.dt, progress=_progress) for k in kinds]
     for res in results:
         print(f"{res.kind} spiral: {res.particulars.vessel} ({res.model})")
         print("  rudder [deg]   r [deg/s]   leg")
@@ -351,7 +351,7 @@ def _simulate_imo(args: argparse.Namespace) -> _Trial:
         raise ValueError("--side does not apply to 'imo' (both sides are tested)")
     if args.angle_deg is not None:
         raise ValueError("--angle-deg does not apply to 'imo' (its trials are fixed)")
-    report = mv.imo_criteria(args.model, dt=args.dt, progress=_progress)
+    report = mv.imo_criteria(args.ship, dt=args.dt, progress=_progress)
     print(mv.format_imo_table(report))
     print(f"overall: {'PASS' if report.passed else 'FAIL'}")
     return report.to_dict(), lambda out: mv.plot_imo(report, out), []
@@ -382,8 +382,16 @@ def _run_simulate(args: argparse.Namespace) -> int:
             raise ValueError(f"{flag} applies to the {only} only, not to {kind!r}")
     if args.plot and Path(args.plot).suffix.lower() != ".png":
         raise ValueError(f"--plot must name a .png file, got {args.plot!r}")
-    print(f"shipgym simulate {kind} --model {args.model} ...", file=sys.stderr, flush=True)
+    if args.params is not None and args.model != "rvg3dof":
+        raise ValueError(f"--params selects an rvg3dof parameter set, not one of {args.model!r}")
+    from shipgym.models import make_model
+
+    args.ship = make_model("rvg3dof", args.params) if args.model == "rvg3dof" else args.model
+    params = f" --params {args.params}" if args.params else ""
+    print(f"shipgym simulate {kind} --model {args.model}{params} ...", file=sys.stderr, flush=True)
     payload, draw, rows = _SIMULATE[kind](args)
+    if args.model == "rvg3dof":
+        payload["params"] = args.ship.params.name
     if kind in ("zigzag", "turning"):
         lu = PARTICULARS[args.model].length_over_speed
         title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
@@ -400,6 +408,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
 
 def _build_simulate(sub: Any) -> None:
     from shipgym.models import MODEL_NAMES
+    from shipgym.models.rvg import RVG_PARAMETER_SETS
 
     p = sub.add_parser(
         "simulate",
@@ -417,6 +426,12 @@ def _build_simulate(sub: Any) -> None:
     p.add_argument("manoeuvre", choices=tuple(_SIMULATE), help="trial to run")
     p.add_argument(
         "--model", default="nomoto1", choices=MODEL_NAMES, help="model (default: %(default)s)"
+    )
+    p.add_argument(
+        "--params",
+        default=None,
+        choices=RVG_PARAMETER_SETS,
+        help="rvg3dof parameter set: seed001 (default) or sea_trials (identified from the trials)",
     )
     p.add_argument(
         "--angle-deg",
@@ -1061,7 +1076,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     import time
     import warnings
 
-    from shipgym.sysid.effects import identify
+    from shipgym.sysid import identify
     from shipgym.sysid.fit import SysidWarning
 
     json_path = _output_path(args.json, "--json")
@@ -1127,7 +1142,7 @@ def _run_identify(args: argparse.Namespace) -> int:
 
 def _build_identify(sub: Any) -> None:
     from shipgym.sysid.data import FORMATS
-    from shipgym.sysid.effects import BASES
+    from shipgym.sysid.families import FAMILIES
 
     p = sub.add_parser(
         "identify",
@@ -1149,7 +1164,9 @@ def _build_identify(sub: Any) -> None:
         choices=FORMATS,
         help="file format (default: detected from the header and the file name)",
     )
-    p.add_argument("--model", default="nomoto1", choices=BASES, help="base model (%(default)s)")
+    p.add_argument(
+        "--model", default="nomoto1", choices=tuple(FAMILIES), help="base model (%(default)s)"
+    )
     p.add_argument(
         "--json",
         default=None,

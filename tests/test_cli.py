@@ -129,3 +129,20 @@ def test_scripts_are_thin_wrappers(script: str) -> None:
     )
     assert proc.returncode == 0, proc.stderr
     assert f"usage: shipgym {script.removesuffix('.py')}" in proc.stdout
+
+
+def test_simulate_takes_the_rvg_parameter_set(tmp_path: Path) -> None:
+    """``--params sea_trials`` simulates the identified Gunnerus (a wider, stable turn at the
+    same azimuth than seed 001's) and is refused for a Nomoto model."""
+    import json
+
+    diam = {}
+    for name in ("seed001", "sea_trials"):
+        out = tmp_path / f"{name}.json"
+        argv = ["simulate", "turning", "--model", "rvg3dof", "--params", name, "--json", str(out)]
+        assert main(argv) == 0
+        doc = json.loads(out.read_text())
+        assert doc["params"] == name
+        diam[name] = doc["tactical_diameter_m"]
+    assert diam["sea_trials"] != pytest.approx(diam["seed001"], rel=0.05)
+    assert main(["simulate", "turning", "--params", "sea_trials"]) == 2

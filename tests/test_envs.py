@@ -924,3 +924,32 @@ def test_observations_float32_in_space(env_id: str) -> None:
         assert isinstance(term, bool) and isinstance(trunc, bool)
         if term:
             obs, _ = env.reset()
+
+
+@pytest.mark.parametrize(
+    "env_id",
+    ["shipgym/RVGHeading-v0", "shipgym/RVGSpeed-v0", "shipgym/RVGPathFollowing-v0",
+     "shipgym/RVGTargetTracking-v0"],
+)  # fmt: skip
+def test_rvg_envs_take_the_parameter_set(env_id: str) -> None:
+    """``params="sea_trials"`` puts the identified Gunnerus in the single and the vector env; the
+    same seed and actions then give another trajectory than seed 001; a bad name is refused."""
+    from shipgym.models import RVGParams
+
+    finals = {}
+    for name in ("seed001", "sea_trials"):
+        env = gym.make(env_id, params=name)
+        assert env.unwrapped.task.model.params.name == name
+        env.reset(seed=3)
+        action = np.full(env.action_space.shape, 0.5, dtype=np.float32)
+        for _ in range(60):
+            obs, *_ = env.step(action)
+        finals[name] = obs
+        env.close()
+    assert not np.allclose(finals["seed001"], finals["sea_trials"])
+    vec = gym.make_vec(env_id, num_envs=2, vectorization_mode="vector_entry_point",
+                       params=RVGParams.sea_trials())  # fmt: skip
+    assert vec.unwrapped.task.model.params.name == "sea_trials"
+    vec.close()
+    with pytest.raises(ValueError, match="sea_trials"):
+        gym.make(env_id, params="real")

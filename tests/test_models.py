@@ -881,3 +881,14 @@ def test_rvg_pod_model_reproduces_the_kongsberg_pod_data() -> None:
         np.testing.assert_allclose(forces[0], [fx, fy], atol=7.0)
         worst_seed = max(worst_seed, abs(forces[1][1] - fy))
     assert worst_seed > 30.0
+
+
+def test_make_model_selects_the_rvg_parameter_set_by_name() -> None:
+    sea = make_model("rvg3dof", "sea_trials").params
+    assert sea.name == "sea_trials" and sea.pod_lift_coefficient > 0
+    assert make_model("rvg3dof", "seed001").params.pod_lift_coefficient == 0.0
+    np.testing.assert_array_equal(sea.linear_damping, RVGParams.sea_trials().linear_damping)
+    with pytest.raises(ValueError, match="seed001"):
+        make_model("rvg3dof", "gunnerus")
+    with pytest.raises(ValueError, match="rvg3dof only"):
+        make_model("nomoto1", "sea_trials")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import importlib.util
 import io
 import json
 import math
@@ -16,7 +15,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from shipgym.cli import main
-from shipgym.sysid.effects import IdentificationResult
+from shipgym.sysid.engine import IdentificationResult
 from shipgym.sysid.generator import generate_record
 from shipgym.sysid.plots import MAX_WINDOW_LINES, plot_identification
 
@@ -188,12 +187,8 @@ def test_identify_checks_the_output_directory_before_the_run(
     assert not PROGRESS.search(stderr)  # refused before loading
 
 
-@pytest.mark.skipif(
-    importlib.util.find_spec("shipgym.sysid.rvg_identify") is None,
-    reason="shipgym.sysid.rvg_identify not available",
-)
 def test_identify_rvg3dof(tmp_path: Path) -> None:
-    from shipgym.sysid.rvg_identify import RVG_WINDOW_S
+    from shipgym.sysid.families.rvg import RVG_WINDOW_S
 
     rec = generate_record(
         None, base_model="rvg3dof", maneuver="zigzag", dt=1.0, duration=300, seed=0

@@ -1,4 +1,7 @@
-"""Tests of the closing-the-loop identifier (shipgym.sysid.effects) on generated records."""
+"""Tests of the identification engine with the Nomoto family on generated records.
+
+:func:`shipgym.sysid.engine.identify` with the bases of :mod:`shipgym.sysid.families.nomoto`.
+"""
 
 from __future__ import annotations
 
@@ -7,9 +10,11 @@ import math
 import numpy as np
 import pytest
 
+from shipgym.sysid import identify
 from shipgym.sysid.data import Record
-from shipgym.sysid.effects import CATALOGUE, NOMOTO_CATALOGUE, RVG_CATALOGUE, identify
-from shipgym.sysid.generator import EFFECTS, EFFECTS_BY_BASE, generate_record
+from shipgym.sysid.families import FAMILIES
+from shipgym.sysid.families.nomoto import NOMOTO_BASES, NOMOTO_EFFECTS, lag_filter
+from shipgym.sysid.generator import EFFECTS_BY_BASE, generate_record
 
 DT = 0.5
 DURATION = 600.0
@@ -20,9 +25,28 @@ def _record(effect: str | None, maneuver: str = "zigzag", seed: int = 0) -> Reco
 
 
 def test_catalogue_matches_generator() -> None:
-    assert set(CATALOGUE) == set(EFFECTS)
-    assert set(NOMOTO_CATALOGUE) == set(EFFECTS_BY_BASE["nomoto1"])
-    assert set(RVG_CATALOGUE) == set(EFFECTS_BY_BASE["rvg3dof"])
+    assert set(NOMOTO_EFFECTS) == set(EFFECTS_BY_BASE["nomoto1"])
+    assert set(FAMILIES["nomoto1"].catalogue) == set(NOMOTO_EFFECTS)
+    # a base that has an effect's term does not offer it
+    assert set(NOMOTO_EFFECTS) - set(FAMILIES["nomoto2"].catalogue) == {"second_order"}
+    assert set(NOMOTO_EFFECTS) - set(FAMILIES["norrbin"].catalogue) == {"yaw_nonlinearity"}
+    assert set(NOMOTO_EFFECTS) - set(FAMILIES["bech"].catalogue) == {
+        "second_order",
+        "yaw_nonlinearity",
+    }
+    for base in NOMOTO_BASES:
+        for effect in FAMILIES[base].catalogue.values():
+            assert effect.term and effect.parameters and effect.source
+    # parameters added (the parsimony rule counts them)
+    n_added = {name: e.n_added for name, e in NOMOTO_EFFECTS.items()}
+    assert n_added == {
+        "rudder_offset": 1,
+        "yaw_nonlinearity": 3,
+        "rudder_lag": 1,
+        "input_delay": 1,
+        "current": 2,
+        "second_order": 2,
+    }
 
 
 @pytest.mark.parametrize("maneuver", ["zigzag", "random"])
@@ -64,7 +88,10 @@ def test_yaw_effect_is_named_first_and_halves_the_error(effect: str) -> None:
     assert res.error_after["psi_rms_deg"] <= 0.5 * res.error_before["psi_rms_deg"]
     ev = res.effects[0]["evidence"]
     assert ev["delta_J"] < 0
-    assert ev["heldout_psi_rms_deg_after"] < ev["heldout_psi_rms_deg_before"]
+    assert ev["relative_drop"] > 0.2
+    assert ev["heldout_rms_after"]["psi"] < ev["heldout_rms_before"]["psi"]
+    # the effect's own parameters, from its catalogue entry
+    assert set(res.effects[0]["parameters"]) >= set(NOMOTO_EFFECTS[effect].parameters)
 
 
 def test_effect_parameters_close_to_truth() -> None:
@@ -86,7 +113,14 @@ def test_current_named_with_positions() -> None:
     p = res.effects[0]["parameters"]
     assert p["V_n"] == pytest.approx(truth["V_n"], abs=0.05)
     assert p["V_e"] == pytest.approx(truth["V_e"], abs=0.05)
+    assert p["speed"] == pytest.approx(math.hypot(p["V_n"], p["V_e"]))
     assert res.error_after["xy_rms_m"] <= 0.5 * res.error_before["xy_rms_m"]
+    ev = res.effects[0]["evidence"]
+    assert ev["evidence_t_stat"] > 5.0
+    # the yaw model is unchanged; the held-out dead-reckoning positions improve
+    assert ev["heldout_rms_after"]["psi"] == ev["heldout_rms_before"]["psi"]
+    assert ev["heldout_rms_after"]["x"] < ev["heldout_rms_before"]["x"]
+    assert res.heldout["error_after"] == res.heldout["error_before"]
 
 
 def test_current_needs_positions() -> None:
@@ -124,8 +158,8 @@ def test_progress_and_validation() -> None:
     assert msgs and msgs[0].startswith("base nomoto1")
     with pytest.raises(ValueError, match="holdout"):
         identify(rec, holdout=0.9)
-    with pytest.raises(ValueError, match="base"):
-        identify(rec, base="abkowitz")
+    with pytest.raises(ValueError, match="model"):
+        identify(rec, "abkowitz")
     with pytest.raises(ValueError, match="max_effects"):
         identify(rec, max_effects=-1)
     with pytest.raises(ValueError, match="Record"):
@@ -136,10 +170,9 @@ def test_progress_and_validation() -> None:
 
 
 def test_lag_filter_is_the_ship_model_steering_gear() -> None:
-    """The compiled ``_lag_filter`` takes the steps of ``ShipModel.simulate`` exactly."""
+    """The compiled ``lag_filter`` takes the steps of ``ShipModel.simulate`` exactly."""
     from shipgym.models import Nomoto1Params, SteeringGear, make_model
     from shipgym.models.nomoto import IDELTA
-    from shipgym.sysid.effects import _lag_filter
 
     rec = _record("rudder_lag")
     t, d = rec.time, rec.delta
@@ -152,4 +185,4 @@ def test_lag_filter_is_the_ship_model_steering_gear() -> None:
     x0[IDELTA] = 0.01
     sim = model.simulate(x0, inputs, h)
     expected = np.interp(t, tf, sim.states[:, IDELTA])
-    np.testing.assert_array_equal(_lag_filter(t, d, 8.0, 0.01), expected)
+    np.testing.assert_array_equal(lag_filter(t, d, 8.0, 0.01), expected)

@@ -249,7 +249,7 @@ def test_effect_catalogue_per_base() -> None:
     assert _RVG_EFFECTS == ("thruster_lift", "azimuth_offset", "current", "sway_offset")
     assert EFFECTS == (*_NOMOTO_EFFECTS, "thruster_lift", "azimuth_offset", "sway_offset")
     assert set(EFFECT_DEFAULTS) == set(EFFECTS)
-    assert EFFECT_DEFAULTS["thruster_lift"] == pytest.approx(6.48e3, rel=0.01)
+    assert EFFECT_DEFAULTS["thruster_lift"] == pytest.approx(5.22e3, rel=0.01)
     assert EFFECT_DEFAULTS["azimuth_offset"] == pytest.approx(math.radians(2.0))
 
 
@@ -368,14 +368,16 @@ def test_rvg_azimuth_offset_differs_from_clean_only_through_the_offset() -> None
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_rvg_thruster_lift_turns_faster_at_the_same_commands(seed: int) -> None:
+def test_rvg_thruster_lift_steadies_the_turns_at_the_same_commands(seed: int) -> None:
+    """The pods' normal force from their own inflow damps sway and yaw like a skeg: at the same
+    orders the ship with it turns more slowly than the directionally unstable seed-001 ship."""
     clean = _rvg(maneuver="random", noise=False, seed=seed)
     rec = _rvg("thruster_lift", maneuver="random", noise=False, seed=seed)
     truth = rec.meta["truth"]
     assert truth["params"]["pod_lift_coefficient"] == pytest.approx(
-        rvg_model.POD_LIFT_COEFFICIENT_THRUSTER_DATA
+        rvg_model.POD_LIFT_COEFFICIENT_FMU
     )
-    assert truth["effect_params"]["c_L"] == pytest.approx(6.48e3, rel=0.01)
+    assert truth["effect_params"]["c_L"] == pytest.approx(5.22e3, rel=0.01)
     np.testing.assert_array_equal(rec.azimuth, clean.azimuth)
     np.testing.assert_array_equal(rec.rpm, clean.rpm)
     # near-steady turns: the same azimuth (>= 10 deg) and rpm held for 30 s or more
@@ -384,7 +386,8 @@ def test_rvg_thruster_lift_turns_faster_at_the_same_commands(seed: int) -> None:
     assert np.all(np.sign(rec.r[steady]) == np.sign(rec.delta[steady]))
     both = steady & (np.sign(clean.r) == np.sign(clean.delta))
     assert both.sum() > 50
-    assert np.all(np.abs(rec.r[both]) > 1.05 * np.abs(clean.r[both]))
+    # (not everywhere: the unstable seed-001 ship is sometimes still swinging into a turn)
+    assert np.median(np.abs(rec.r[both]) / np.abs(clean.r[both])) < 0.85
 
 
 @pytest.mark.parametrize("maneuver", ["zigzag", "random"])

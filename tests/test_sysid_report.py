@@ -146,7 +146,7 @@ def _rows() -> list[dict[str, Any]]:
         "samples_total": 1201,
         "model": "rvg3dof",
         "status": "skipped",
-        "message": "base rvg3dof unavailable: shipgym.sysid.rvg_identify not importable",
+        "message": "base rvg3dof unavailable: no rvg3dof family registered",
     }
     return [_ok_row(), failed, gunnerus_n, gunnerus_rvg, skipped]
 
@@ -337,7 +337,7 @@ def test_rvg3dof_applies_to_pod_records_and_is_skipped_when_unavailable(monkeypa
         records=[rvg, nomoto], models=("rvg3dof",), progress=False, identify_fn=never
     )
     assert len(rows) == 1
-    assert rows[0]["status"] == "skipped" and "rvg_identify" in rows[0]["message"]
+    assert rows[0]["status"] == "skipped" and "rvg3dof family" in rows[0]["message"]
 
 
 def test_prepare_record_cuts_to_the_marked_manoeuvre() -> None:
@@ -395,14 +395,14 @@ def test_benchmark_table_and_plot(tmp_path: Path) -> None:
                 "median_s": None,
                 "ratio": None,
                 "met": None,
-                "skipped": "shipgym.sysid.rvg_identify not available",
+                "skipped": "no rvg3dof family registered",
             },
         ],
     }
     table = format_benchmark(rep)
     assert "| nomoto1 output-error fit | 10001 | 0.450 | 3 | 1 | 0.450 | met |" in table
     assert "| identify loop | 10001 | 25.000 | 1 | 10 | 2.500 | missed |" in table
-    assert "skipped: shipgym.sysid.rvg_identify not available" in table
+    assert "skipped: no rvg3dof family registered" in table
     path = plot_benchmark(rep, tmp_path / "bench_sysid.png")
     assert path.read_bytes()[:8] == PNG_MAGIC
 

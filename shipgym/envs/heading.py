@@ -135,8 +135,11 @@ class RVGHeadingEnv(ShipEnv):
     ## Arguments
 
     ``gymnasium.make("shipgym/RVGHeading-v0", max_current_speed=0.5, max_azimuth=0.61,
-    setpoint_interval=100.0, render_mode=None)``. Reset options and ``info`` as for
-    ``NomotoHeading-v0``.
+    setpoint_interval=100.0, params="seed001", render_mode=None)``. Reset options and
+    ``info`` as for ``NomotoHeading-v0``.
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
+    trials) or an ``RVGParams``.
 
     ## Version History
 

@@ -62,10 +62,13 @@ class RVGPathFollowingEnv(ShipEnv):
     ## Arguments
 
     ``gymnasium.make("shipgym/RVGPathFollowing-v0", max_current_speed=0.5, max_azimuth=0.61,
-    accept_radius=67.8, max_cross_track=250.0, render_mode=None)``. Reset options:
+    accept_radius=67.8, max_cross_track=250.0, params="seed001", render_mode=None)``. Reset options:
     ``current_speed``, ``current_direction``, ``initial_state``, ``waypoints`` (2 to 16
     (north, east) points [m]). ``info`` holds ``state``, the current, ``cross_track_error``,
     ``segment``, ``completed`` and ``termination_reason``.
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
+    trials) or an ``RVGParams``.
 
     ## Version History
 

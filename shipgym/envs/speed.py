@@ -49,9 +49,13 @@ class RVGSpeedEnv(ShipEnv):
     ## Arguments
 
     ``gymnasium.make("shipgym/RVGSpeed-v0", max_current_speed=0.5, setpoint_interval=200.0,
-    render_mode=None)``. Reset options: ``current_speed``, ``current_direction``,
+    params="seed001", render_mode=None)``. Reset options: ``current_speed``,
+    ``current_direction``,
     ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s] >= 0). ``info`` holds ``state``,
     the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
+    trials) or an ``RVGParams``.
 
     ## Version History
 

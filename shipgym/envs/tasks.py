@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.envs import kernels
-from shipgym.models import NOMOTO_MODEL_NAMES, ShipModel, make_model
+from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
 from shipgym.models.angles import ssa
 from shipgym.models.integrate import PARALLEL_MIN_ROWS
 from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
@@ -383,7 +383,7 @@ class RVGMixin:
     def _setup_rvg(self, max_azimuth: float) -> None:
         if not (math.isfinite(max_azimuth) and 0 < max_azimuth <= math.pi):
             raise ValueError(f"max_azimuth must be in (0, pi] rad, got {max_azimuth!r}")
-        self.params = make_model("rvg3dof").params
+        self.params = self.model.params
         self.max_azimuth = float(max_azimuth)
         self.bollard = self.params.bollard_thrust
 
@@ -434,8 +434,10 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
         max_current_speed: float = 0.5,
         max_azimuth: float = math.radians(35.0),
         setpoint_interval: float = 100.0,
+        params: str | RVGParams = "seed001",
     ) -> None:
-        HeadingTask.__init__(self, n, make_model("rvg3dof"), max_current_speed, setpoint_interval)
+        model = make_model("rvg3dof", params)
+        HeadingTask.__init__(self, n, model, max_current_speed, setpoint_interval)
         self._setup_rvg(max_azimuth)
         ts = self.params.service_thrust
         self.u0[:] = (ts, ts, 0.0, 0.0)
@@ -469,8 +471,9 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
         max_current_speed: float = 0.5,
         max_azimuth: float = math.radians(35.0),
         setpoint_interval: float = 200.0,
+        params: str | RVGParams = "seed001",
     ) -> None:
-        Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
+        Task.__init__(self, n, make_model("rvg3dof", params), max_current_speed)
         self._setup_rvg(max_azimuth)
         self._setup_schedule(setpoint_interval)
         half = 0.5 * self.bollard
@@ -544,8 +547,9 @@ class RVGPathTask(RVGMixin, Task):
         max_azimuth: float = math.radians(35.0),
         accept_radius: float = 2.0 * LPP,
         max_cross_track: float = 250.0,
+        params: str | RVGParams = "seed001",
     ) -> None:
-        Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
+        Task.__init__(self, n, make_model("rvg3dof", params), max_current_speed)
         self._setup_rvg(max_azimuth)
         self.accept_radius = _positive("accept_radius", accept_radius)
         self.max_cross_track = _positive("max_cross_track", max_cross_track)
@@ -703,8 +707,9 @@ class RVGTargetTask(RVGMixin, Task):
         max_azimuth: float = math.radians(35.0),
         distance: float = 50.0,
         max_distance: float = 3000.0,
+        params: str | RVGParams = "seed001",
     ) -> None:
-        Task.__init__(self, n, make_model("rvg3dof"), max_current_speed)
+        Task.__init__(self, n, make_model("rvg3dof", params), max_current_speed)
         self._setup_rvg(max_azimuth)
         self.default_distance = _positive("distance", distance)
         self.max_distance = _positive("max_distance", max_distance)

@@ -305,8 +305,10 @@ def make_model(
     ----------
     name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof"}
         Model name.
-    params : dataclass, optional
-        Parameters of the right type (e.g. :class:`Nomoto1Params`); defaults otherwise.
+    params : dataclass or str, optional
+        Parameters of the right type (e.g. :class:`Nomoto1Params`); defaults otherwise. For
+        ``rvg3dof`` also the name of a shipped set (``"seed001"``, ``"sea_trials"``:
+        :meth:`RVGParams.named`).
     gear, surge : SteeringGear, SurgeModel, optional
         Steering gear and surge model of the Nomoto family.
 
@@ -322,6 +324,13 @@ def make_model(
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
     expected = RVGParams if name == "rvg3dof" else _DEFAULT_YAW[name]
+    if isinstance(params, str):
+        if name != "rvg3dof":
+            raise ValueError(
+                f"a parameter set name ({params!r}) selects a shipped set of rvg3dof only; "
+                f"model {name!r} takes {expected.__name__}"
+            )
+        params = RVGParams.named(params)
     if params is None:
         params = expected()
     elif not isinstance(params, expected):

@@ -5,12 +5,16 @@
   standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
 * ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive
   backstepping identifier of seed 002.
-* ``shipgym.sysid.effects``: residual diagnosis and the effect-catalogue loop
-  (:func:`identify`) for the Nomoto family.
+* ``shipgym.sysid.engine``: the identification loop (:func:`identify`): a base model, then the
+  effects of its family's catalogue while the held-out score improves.
+* ``shipgym.sysid.families``: the model families of the loop (``nomoto``: the Nomoto family
+  and :func:`residual_diagnostics`; ``rvg``: the R/V Gunnerus 3-DOF model), registered by model
+  name.
 * ``shipgym.sysid.generator``: synthetic records with one undeclared effect of the catalogue,
   the known truth for testing identification.
 """
 
+import shipgym.sysid.families  # noqa: F401 (registers the model families of identify)
 from shipgym.sysid.data import (
     FORMATS,
     Record,
@@ -20,7 +24,8 @@ from shipgym.sysid.data import (
     load,
     load_all,
 )
-from shipgym.sysid.effects import IdentificationResult, identify, residual_diagnostics
+from shipgym.sysid.engine import IdentificationResult, identify
+from shipgym.sysid.families.nomoto import residual_diagnostics
 from shipgym.sysid.fit import FitResult, fit_equation_error, fit_output_error
 from shipgym.sysid.generator import EFFECTS, generate_record
 from shipgym.sysid.recursive import BacksteppingIdentifier, RecursiveLeastSquares, run_rls

@@ -1,8 +1,8 @@
 """Figure of an identification run: measured vs base model vs model with the added effects.
 
 :func:`plot_identification` draws the ``traces`` of an
-:class:`~shipgym.sysid.effects.IdentificationResult` (the Nomoto family of
-:func:`shipgym.sysid.effects.identify` and ``rvg3dof`` alike):
+:class:`~shipgym.sysid.engine.IdentificationResult` (the Nomoto family of
+:func:`shipgym.sysid.engine.identify` and ``rvg3dof`` alike):
 
 * one row per channel against time: heading ``psi`` [deg], yaw rate ``r`` [deg/s] and, where
   the record has it, surge speed ``u`` [m/s]; each with the measured signal, the simulation of
@@ -75,7 +75,7 @@ def format_errors(before: Mapping[str, Any], after: Mapping[str, Any]) -> str:
     ----------
     before, after : mapping
         Error dicts such as ``error_before`` and ``error_after`` of an
-        :class:`~shipgym.sysid.effects.IdentificationResult` (keys of :data:`METRIC_LABELS`;
+        :class:`~shipgym.sysid.engine.IdentificationResult` (keys of :data:`METRIC_LABELS`;
         other keys are shown by name).
     """
     parts = []
@@ -106,7 +106,7 @@ def plot_identification(
     Parameters
     ----------
     result : IdentificationResult
-        Output of :func:`shipgym.sysid.effects.identify` (any base); its ``traces`` must hold
+        Output of :func:`shipgym.sysid.engine.identify` (any base); its ``traces`` must hold
         ``time``, ``psi`` and ``r``.
     path : str or pathlib.Path, optional
         Write the figure there (the format follows the suffix, PNG for ``.png``).
@@ -129,7 +129,7 @@ def plot_identification(
     missing = [k for k in ("time", "psi", "r") if k not in tr]
     if missing:
         raise ValueError(
-            f"result.traces lacks {missing}; expected the traces of shipgym.sysid.effects.identify"
+            f"result.traces lacks {missing}; expected the traces of shipgym.sysid.engine.identify"
         )
     t = np.asarray(tr["time"], dtype=float)
     n = t.size

@@ -4,7 +4,7 @@ Issue 4 ("System identification that closes the loop with measured data"):
 
 * "Every measured dataset: a table in the README (or a linked doc) with error before and
   after, the effects found and the parameters, produced by one script" -> :func:`identify_all`
-  runs :func:`shipgym.sysid.effects.identify` on every record (``nomoto1``, seed 000
+  runs :func:`shipgym.sysid.engine.identify` on every record (``nomoto1``, seed 000
   ``T r' + r = K delta``, on all of them; also ``rvg3dof``, the R/V Gunnerus 3-DOF model of
   seed 001, on the records with pod channels, i.e. the Gunnerus sea trials);
   :func:`render_table` is the compact table, :func:`render_markdown` the README block around it
@@ -47,7 +47,8 @@ from typing import Any, TextIO
 import numpy as np
 
 from shipgym.sysid.data import Record, load, load_all
-from shipgym.sysid.effects import IdentificationResult, identify
+from shipgym.sysid.engine import IdentificationResult, identify
+from shipgym.sysid.families.base import FAMILIES
 
 __all__ = [
     "BENCH_GOALS",
@@ -164,11 +165,8 @@ def _say(progress: ProgressArg) -> Callable[[str], None]:
 # records and models
 # ----------------------------------------------------------------------------------------------
 def rvg_available() -> bool:
-    """True when the ``rvg3dof`` base (:mod:`shipgym.sysid.rvg_identify`) can be imported."""
-    try:
-        return importlib.util.find_spec("shipgym.sysid.rvg_identify") is not None
-    except (ImportError, ValueError):  # pragma: no cover - broken package state
-        return False
+    """True when the ``rvg3dof`` family (:mod:`shipgym.sysid.families.rvg`) is registered."""
+    return "rvg3dof" in FAMILIES
 
 
 def model_applies(model: str, record: Record) -> bool:
@@ -299,11 +297,11 @@ def identify_all(
     models : sequence of str, optional
         Bases to run (:data:`DEFAULT_MODELS` by default), each on the records it applies to
         (:func:`model_applies`). ``rvg3dof`` is reported as ``"skipped"`` while
-        :mod:`shipgym.sysid.rvg_identify` is not available.
+        :mod:`shipgym.sysid.families.rvg` is not registered.
     only : str, optional
         Keep the records whose ``source/file`` contains this text (case-insensitive).
     holdout, max_effects, window_s
-        Passed to :func:`shipgym.sysid.effects.identify`.
+        Passed to :func:`shipgym.sysid.engine.identify`.
     trim : bool
         Cut records to the manoeuvre marked by their loader (:func:`prepare_record`).
     progress : callable, file or bool
@@ -315,7 +313,7 @@ def identify_all(
         Called as ``on_result(record, result, row)`` after each successful identification (the
         record as identified); e.g. to draw a per-record figure from ``result.traces``.
     identify_fn : callable
-        The identifier (:func:`shipgym.sysid.effects.identify`; replaceable for tests).
+        The identifier (:func:`shipgym.sysid.engine.identify`; replaceable for tests).
 
     Returns
     -------
@@ -363,7 +361,7 @@ def identify_all(
         row["warnings"] = []
         if model == "rvg3dof" and not have_rvg:
             row["status"] = "skipped"
-            row["message"] = "base rvg3dof unavailable: shipgym.sysid.rvg_identify not importable"
+            row["message"] = "base rvg3dof unavailable: no rvg3dof family registered"
             say(f"{head}: skipped ({row['message']})")
             rows.append(row)
             continue
@@ -615,7 +613,7 @@ def _gunnerus_text(rows: Sequence[Mapping[str, Any]]) -> list[str]:
         "* *seed 001* (`rvg3dof` only): the model with the published seed-001 parameters, "
         "driven by the recorded azimuth and rpm orders, against the record; nothing fitted.",
         "* *before*: the base model fitted to the record (`rvg3dof`: its free parameters "
-        "calibrated, see `shipgym.sysid.rvg_identify`).",
+        "calibrated within documented ranges, see `shipgym.sysid.families.rvg`).",
         "* *after*: the base model plus the effects the residual was traced to, each accepted "
         "only if it lowers the score on the held-out part.",
         "* *held-out*: the end of the record, which no fit saw: the models are fitted on the "
@@ -985,11 +983,11 @@ def benchmark_sysid(
 
     * ``fit``: :func:`shipgym.sysid.fit.fit_output_error` of ``nomoto1`` on a generated
       random-rudder record of 10 001 samples (``dt = 0.1`` s, 1000 s); median of ``repeats``;
-    * ``loop``: :func:`shipgym.sysid.effects.identify` (``nomoto1``) on a generated 10 001-sample
+    * ``loop``: :func:`shipgym.sysid.engine.identify` (``nomoto1``) on a generated 10 001-sample
       zigzag with the effect ``effect``; median of ``repeats``;
     * ``gunnerus``: ``identify(record, "rvg3dof")`` on the Gunnerus sea trials under ``root``;
       one run (skipped with a reason when ``root`` is None, the file is missing or
-      :mod:`shipgym.sysid.rvg_identify` is not available).
+      :mod:`shipgym.sysid.families.rvg` is not registered).
 
     ``duration`` [s] sets the length of the generated records (1000 s: 10 001 samples; shorter
     only for smoke tests). Each is preceded by an untimed warm-up on a short record (Numba
@@ -1085,7 +1083,7 @@ def benchmark_sysid(
     elif not path.is_file():
         add("gunnerus", desc, None, [], skipped=f"Gunnerus record not found ({path})")
     elif not rvg_available():
-        add("gunnerus", desc, None, [], skipped="shipgym.sysid.rvg_identify not available")
+        add("gunnerus", desc, None, [], skipped="no rvg3dof family registered")
     else:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

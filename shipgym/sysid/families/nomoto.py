@@ -1,18 +1,21 @@
-"""Closing the identification loop: trace the residual of a fit to one effect of a catalogue.
+"""The Nomoto family: trace the residual of a yaw fit to one effect of a catalogue.
 
-Issue 4 section 3. Starting from a base Nomoto fit (seed 000 ``T r' + r = K delta``), the loop
+Issue 4 section 3. The bases are the Nomoto-family yaw models of :mod:`shipgym.models`:
+``nomoto1`` (seed 000, ``T r' + r = K delta``), ``nomoto2`` (seed 004 eq. 1), ``norrbin``
+(seed 002 eq. 1) and ``bech`` (seed 004 eq. 3), one :class:`NomotoFamily` each. The engine
+(:func:`shipgym.sysid.engine.identify`) runs the loop; this family
 
 1. fits the current model by output error (:func:`shipgym.sysid.fit.fit_output_error`) on the
    training part of the record (the first ``1 - holdout`` fraction);
-2. analyses the residual (:func:`residual_diagnostics`): simulation-error RMS of ``psi`` and
-   ``r``, equation error, a Ljung-Box whiteness statistic of the ``r`` residual, its
-   cross-correlation with the rudder at lags and the least-squares fit of the residual against
-   the signature of each candidate effect (the sensitivity of the simulated ``r`` to the effect's
-   parameter, by finite differences through :func:`shipgym.sysid.fit.replay`);
-3. for each candidate effect of :data:`CATALOGUE` not yet in the model, fits the augmented model
-   on the training part and scores it on the held-out part (see *Criterion*);
-4. accepts the best candidate if it is significant and repeats (at most ``max_effects``); stops
-   when none is.
+2. for each candidate effect of its catalogue (:data:`NOMOTO_EFFECTS`) not yet in the model,
+   fits the augmented model on the training part and scores it on the held-out part (see
+   *Criterion*);
+3. reports the residual analysis of the whole-record fits (:func:`residual_diagnostics`):
+   simulation-error RMS of ``psi`` and ``r``, equation error, a Ljung-Box whiteness statistic of
+   the ``r`` residual, its cross-correlation with the rudder at lags and the least-squares fit
+   of the residual against the signature of each candidate effect (the sensitivity of the
+   simulated ``r`` to the effect's parameter, by finite differences through
+   :func:`shipgym.sysid.fit.replay`).
 
 Augmented models (all simulated by :mod:`shipgym.models` through ``replay``):
 
@@ -23,15 +26,16 @@ Augmented models (all simulated by :mod:`shipgym.models` through ``replay``):
 * ``rudder_lag``: the recorded rudder is taken as the COMMAND of the project's steering gear
   (:class:`shipgym.models.SteeringGear`, seed 002 eq. 2: first-order, time constant ``T_d``,
   default 35 deg / 2.32 deg/s limits), simulated with the RK4 steps of
-  :meth:`ShipModel.simulate` (compiled); ``T_d`` by a grid plus bounded 1-D search around the
-  output-error fit. The gear's initial angle is
-  estimated from the base fit and the initial yaw acceleration (``(T r'(0) + r(0)) / K``);
+  :meth:`ShipModel.simulate` (compiled, :func:`lag_filter`); ``T_d`` by a grid plus bounded 1-D
+  search around the output-error fit. The gear's initial angle is estimated from the base fit
+  and the initial yaw acceleration (``(T r'(0) + r(0)) / K``);
 * ``input_delay``: the recorded rudder shifted by ``tau`` (linear interpolation, first sample
   held before the start), ``tau`` by a bounded 1-D search;
 * ``current``: only with positions. Dead reckoning ``x' = U cos psi``, ``y' = U sin psi`` from
   the recorded heading and speed (trapezoidal integration); the position residual is regressed
-  on ``[1, t]`` per axis, the slope is the drift velocity ``(V_n, V_e)``. A Nomoto model's yaw
-  does not see a uniform current, so this candidate is scored on the positions only.
+  on ``[1, t]`` per axis, the slope is the drift velocity ``(V_n, V_e)`` (a steady, uniform
+  current, seed 001 eq. 7-12). A Nomoto model's yaw does not see a uniform current, so this
+  candidate is scored on the positions only.
 
 Criterion
 ---------
@@ -47,7 +51,8 @@ of squares ``RSS_psi``, ``RSS_r`` the score is the Gaussian (unknown-variance) B
 with ``k`` the number of model parameters (plus the held-out ``r'(0)`` of second-order
 models). A candidate is accepted when both
 
-* ``J_candidate - J_current < -BIC_MARGIN`` (:data:`BIC_MARGIN`), and
+* ``J_candidate - J_current < -BIC_MARGIN``
+  (:data:`~shipgym.sysid.families.base.BIC_MARGIN`), and
 * the held-out heading RMS drops by more than :data:`MIN_RELATIVE_DROP` (a guard against the
   strongly correlated simulation residual, which makes ``n`` overstate the information).
 
@@ -56,17 +61,23 @@ behind a first-order rudder lag (``T_d = T2``), so the two are nearly indistingu
 data; when ``second_order`` wins but its ``|T3| < LAG_EQUIVALENT_T3 * T2`` and ``rudder_lag`` is
 also significant, ``rudder_lag`` (one parameter fewer) is chosen.
 
-Parsimony: the candidates whose ``J`` change is within :data:`TIE_FRACTION` (2 %) of the best
-one are tied, and the one adding the fewest parameters wins (``rudder_offset``, ``rudder_lag``,
-``input_delay``: 1; ``second_order``, ``current``: 2; ``yaw_nonlinearity``: 3). A slow
-second-order mode can mimic a rudder offset on a random manoeuvre, and a delay, a lag and a
-second-order model without zero all look like an input phase lag, to within about 1 % of ``J``.
+Parsimony: the candidates whose ``J`` change is within
+:data:`~shipgym.sysid.families.base.TIE_FRACTION` (2 %) of the best one are tied, and the one
+adding the fewest parameters wins (``rudder_offset``, ``rudder_lag``, ``input_delay``: 1;
+``second_order``, ``current``: 2; ``yaw_nonlinearity``: 3). A slow second-order mode can mimic a
+rudder offset on a random manoeuvre, and a delay, a lag and a second-order model without zero
+all look like an input phase lag, to within about 1 % of ``J``.
 
 For ``current`` ``J`` is the same expression on the ``x``/``y`` held-out residuals of the dead
-reckoning (with and without drift, two extra parameters), and the drift must also exceed
-:data:`CURRENT_T_MIN` standard errors. Among the accepted candidates the one with the most
-negative ``J`` change wins; the yaw score and the position score are both log-likelihood ratios,
-so they are compared directly.
+reckoning (with and without drift, two extra parameters), its relative drop is that of the
+held-out position RMS, and the drift must also exceed :data:`CURRENT_T_MIN` standard errors.
+Among the accepted candidates the one with the most negative ``J`` change wins; the yaw score
+and the position score are both log-likelihood ratios, so they are compared directly.
+Accepting ``current`` leaves the yaw model (and its score) as it was and adds the drift.
+
+Held-out RMS (``heldout_rms`` of the candidates, the evidence of accepted effects): ``psi``
+[rad] and ``r`` [rad/s] of the held-out prediction and, with positions, ``x``, ``y`` [m] of the
+dead reckoning (without, then with the drift).
 
 Cost
 ----
@@ -85,10 +96,9 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -100,6 +110,17 @@ from shipgym.models._jit import kernel
 from shipgym.models.integrate import NOMOTO1, rk4_row
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
+from shipgym.sysid.families.base import (
+    Candidate,
+    Effect,
+    ModelFamily,
+    errors,
+    ljung_box,
+    register,
+    window_starts,
+    wrap,
+    xcorr,
+)
 from shipgym.sysid.fit import (
     FitResult,
     SysidWarning,
@@ -109,39 +130,20 @@ from shipgym.sysid.fit import (
 )
 
 __all__ = [
-    "BIC_MARGIN",
-    "CATALOGUE",
+    "AUTO_WINDOW_DURATION",
+    "AUTO_WINDOW_S",
     "CURRENT_T_MIN",
     "LAG_EQUIVALENT_T3",
     "MIN_RELATIVE_DROP",
-    "NOMOTO_CATALOGUE",
-    "RVG_CATALOGUE",
-    "TIE_FRACTION",
-    "IdentificationResult",
-    "identify",
+    "NOMOTO_BASES",
+    "NOMOTO_EFFECTS",
+    "NomotoFamily",
+    "lag_filter",
     "residual_diagnostics",
 ]
 
-NOMOTO_CATALOGUE: tuple[str, ...] = (
-    "rudder_offset",
-    "yaw_nonlinearity",
-    "rudder_lag",
-    "input_delay",
-    "current",
-    "second_order",
-)
-"""Effects the loop can add to a Nomoto-family base."""
-
-RVG_CATALOGUE: tuple[str, ...] = ("thruster_lift", "azimuth_offset", "current", "sway_offset")
-"""Effects the loop can add to the ``rvg3dof`` base (:mod:`shipgym.sysid.rvg_identify`)."""
-
-CATALOGUE: tuple[str, ...] = NOMOTO_CATALOGUE + tuple(
-    e for e in RVG_CATALOGUE if e not in NOMOTO_CATALOGUE
-)
-"""Every effect name (the names of :data:`shipgym.sysid.generator.EFFECTS`)."""
-
-BIC_MARGIN = 10.0
-"""Required decrease of the held-out BIC ``J`` to accept an effect."""
+NOMOTO_BASES: tuple[str, ...] = ("nomoto1", "nomoto2", "norrbin", "bech")
+"""The Nomoto-family bases (model names of :func:`shipgym.sysid.engine.identify`)."""
 
 MIN_RELATIVE_DROP = 0.20
 """Required relative drop of the held-out heading RMS (yaw effects) or position RMS (current).
@@ -157,37 +159,15 @@ default sizes drop the held-out heading error by 50-99 %.
 LAG_EQUIVALENT_T3 = 0.5
 """``second_order`` with ``|T3| < LAG_EQUIVALENT_T3 * T2`` is read as ``rudder_lag``."""
 
-TIE_FRACTION = 0.02
-"""Candidates whose BIC change is within this fraction of the best are tied (parsimony)."""
-
-_N_ADDED = {
-    "rudder_offset": 1,
-    "yaw_nonlinearity": 3,
-    "rudder_lag": 1,
-    "input_delay": 1,
-    "current": 2,
-    "second_order": 2,
-}
-
 CURRENT_T_MIN = 5.0
 """Required ``|V| / stderr(V)`` of the drift velocity for ``current``."""
 
-BASES: tuple[str, ...] = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof")
-"""Base models of :func:`identify`."""
-
-_BASE_CONFIG = {
-    "nomoto1": {},
-    "nomoto2": {"second": True},
-    "norrbin": {"nonlinear": True},
-    "bech": {"second": True, "nonlinear": True},
-}
-_IN_BASE = {"second": "second_order", "nonlinear": "yaw_nonlinearity"}
-
 AUTO_WINDOW_DURATION = 1000.0
-"""Nomoto-family records longer than this [s] are scored in windows of :data:`AUTO_WINDOW_S`."""
+"""Records longer than this [s] are scored in windows of :data:`AUTO_WINDOW_S`."""
 
 AUTO_WINDOW_S = 300.0
-"""Window [s] for long Nomoto-family records (``window_s="auto"``)."""
+"""Window [s] for long records (``window_s="auto"``)."""
+
 _LAG_BOUNDS = (0.1, 40.0)
 _DELAY_BOUNDS = (0.0, 15.0)
 _SEARCH_SAMPLES = 2000
@@ -203,6 +183,81 @@ _POLISH_NFEV = 100
 """Budget of the second pass on every sample of a segment longer than :data:`_SEARCH_SAMPLES`."""
 _LJUNG_BOX_LAGS = 20
 _XCORR_LAGS = (0, 2, 5, 10, 20, 40)
+_INITIAL_STATE = ("psi0", "r0", "r_dot0")
+_FIT_ERRORS = (ValueError, TypeError, np.linalg.LinAlgError)
+
+
+# --------------------------------------------------------------------------------------------
+# the catalogue
+
+_SECOND_ORDER_BASES = ("nomoto2", "bech")
+_NONLINEAR_BASES = ("norrbin", "bech")
+
+
+def _catalogue(base: str) -> dict[str, Effect]:
+    """The effects a ``base`` can take (those whose term it lacks), in the order tried."""
+    second = base in _SECOND_ORDER_BASES
+    offset = {"nomoto1": "delta0", "nomoto2": "delta0", "norrbin": "n0", "bech": "b0"}[base]
+    coef = "b" if second else "n"
+    effects = [
+        Effect(
+            "rudder_offset",
+            {
+                "delta0": "delta -> delta + delta0",
+                "n0": "H(r) += n0 (n0 = -K delta0)",
+                "b0": "H_B(r) += b0 (b0 = -delta0)",
+            }[offset],
+            (offset,),
+            {},
+            "seed 000 (regression constant c, delta0 = c / b); seed 002 eq. 4 (a0 = -n0 / T: "
+            "hull asymmetry, wind, waves, current)",
+        ),
+        Effect(
+            "yaw_nonlinearity",
+            f"r -> H(r) = {coef}3 r^3 + {coef}2 r|r| + {coef}1 r (|{coef}1 K| = 1)",
+            (f"{coef}1", f"{coef}2", f"{coef}3"),
+            {},
+            "seed 002 eq. 1 (Norrbin); seed 004 eq. 3 (Bech, with second_order)",
+        ),
+        Effect(
+            "rudder_lag",
+            "T_d delta' + delta = delta_recorded (|delta| <= 35 deg, |delta'| <= 2.32 deg/s)",
+            ("T_d",),
+            {"T_d": _LAG_BOUNDS},
+            "seed 002 eq. 2 (steering gear, shipgym.models.SteeringGear)",
+        ),
+        Effect(
+            "input_delay",
+            "delta(t) = delta_recorded(t - tau)",
+            ("tau",),
+            {"tau": _DELAY_BOUNDS},
+            "a transport delay between the rudder log and the ship",
+        ),
+        Effect(
+            "current",
+            "x' = U cos psi + V_n, y' = U sin psi + V_e",
+            ("V_n", "V_e"),
+            {},
+            "seed 001 eq. 7-12 (steady, uniform current); dead reckoning of the track",
+        ),
+        Effect(
+            "second_order",
+            "T1 T2 r'' + (T1 + T2) r' + r = K (delta + T3 delta') (T1 replaces T)",
+            ("T2", "T3"),
+            {"T2": (1e-6, math.inf)},
+            "seed 004 eq. 1; seed 000 (second-order Nomoto model)",
+        ),
+    ]
+    skip = {"second_order"} if second else set()
+    if base in _NONLINEAR_BASES:
+        skip.add("yaw_nonlinearity")
+    return {e.name: e for e in effects if e.name not in skip}
+
+
+NOMOTO_EFFECTS: dict[str, Effect] = _catalogue("nomoto1")
+"""Every effect of the Nomoto family (the catalogue of ``nomoto1``; a base that has an effect's
+term does not offer it: ``nomoto2`` ``second_order``, ``norrbin`` ``yaw_nonlinearity``, ``bech``
+both)."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -235,31 +290,44 @@ class _Config:
         }[name]
         return _Config(**{**self.__dict__, key: True})
 
+    @classmethod
+    def of_base(cls, base: str) -> _Config:
+        return cls(second=base in _SECOND_ORDER_BASES, nonlinear=base in _NONLINEAR_BASES)
+
 
 @dataclass
 class _Fitted:
+    """A yaw fit with its input filters and, with ``current``, the drift of the track."""
+
     config: _Config
     fit: FitResult
     T_d: float = 0.0
     tau: float = 0.0
     y0: float | None = None
+    drift: tuple[float, float] | None = None
+    """Whole-record drift ``(V_n, V_e)`` [m/s] once ``current`` is in the model."""
+    positions: bool = False
+    """Whether the record can take ``current`` (positions and a speed)."""
 
     @property
     def n_params(self) -> int:
-        skip = {"psi0", "r0", "r_dot0"}
         return (
-            sum(1 for k in self.fit.free if k not in skip)
+            sum(1 for k in self.fit.free if k not in _INITIAL_STATE)
             + int(self.config.lag)
             + int(self.config.delay)
         )
 
     def parameters(self) -> dict[str, float]:
-        out = {k: float(v) for k, v in self.fit.values.items() if k not in ("psi0", "r0", "r_dot0")}
+        out = {k: float(v) for k, v in self.fit.values.items() if k not in _INITIAL_STATE}
         if self.config.lag:
             out["T_d"] = self.T_d
         if self.config.delay:
             out["tau"] = self.tau
         return out
+
+
+# --------------------------------------------------------------------------------------------
+# rudder input: steering-gear lag and delay
 
 
 @kernel
@@ -283,14 +351,29 @@ def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
         out[k + 1] = x[0, IDELTA]
 
 
-def _lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = None) -> np.ndarray:
+def lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = None) -> np.ndarray:
     """The recorded rudder ``u`` as a command through the project's steering gear.
 
     :class:`shipgym.models.SteeringGear` with time constant ``T_d`` and the default angle and
     rate limits (35 deg, 2.32 deg/s, seed 002 eq. 2), simulated with the steps of
-    :meth:`ShipModel.simulate` (compiled, :func:`_gear_kernel`) on a fine grid (step at most
-    0.1 s, the command held over each step) and read back at ``t``; the initial actual rudder
-    is ``y0`` (``u(0)`` by default).
+    :meth:`ShipModel.simulate` (compiled) on a fine grid (step at most 0.1 s, the command held
+    over each step) and read back at ``t``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Sample times [s].
+    u : numpy.ndarray
+        Recorded rudder [rad], the gear's command.
+    T_d : float
+        Gear time constant [s].
+    y0 : float, optional
+        Initial actual rudder [rad] (``u[0]`` by default).
+
+    Returns
+    -------
+    numpy.ndarray
+        The actual rudder [rad] at ``t``.
     """
     dt = float(np.median(np.diff(t)))
     m = max(1, math.ceil(dt / 0.1 - 1e-9))
@@ -337,12 +420,17 @@ def _shift(t: np.ndarray, u: np.ndarray, tau: float) -> np.ndarray:
 def _input(
     cfg: _Config, t: np.ndarray, delta: np.ndarray, T_d: float, tau: float, y0: float | None = None
 ) -> np.ndarray:
+    """The rudder the model sees: the record delayed by ``tau``, then through the gear."""
     d = delta
     if cfg.delay and tau > 0.0:
         d = _shift(t, d, tau)
     if cfg.lag and T_d > 0.0:
-        d = _lag_filter(t, d, T_d, y0)
+        d = lag_filter(t, d, T_d, y0)
     return d
+
+
+# --------------------------------------------------------------------------------------------
+# fits
 
 
 def _fit_config(
@@ -516,7 +604,7 @@ def _predict(
         x = x0.copy()
         x[free] = z
         sim = replay(name, params, th, dh, x)
-        out = np.concatenate((_wrap(sim[:, 2] - ph) / sigma[0], (sim[:, 4] - rh) / sigma[1]))
+        out = np.concatenate((wrap(sim[:, 2] - ph) / sigma[0], (sim[:, 4] - rh) / sigma[1]))
         return out if np.all(np.isfinite(out)) else np.full(out.shape, 1e6)
 
     with np.errstate(all="ignore"):
@@ -535,11 +623,12 @@ def _score(
     split: int,
     sigma: tuple[float, float],
 ) -> dict[str, float]:
+    """Held-out BIC ``J``, RMS of ``psi`` [rad] and ``r`` [rad/s] and ``k`` of a training fit."""
     sim = _predict(fitted, t, delta, psi, r, split, sigma)
     if not np.all(np.isfinite(sim[:, [2, 4]])):  # the prediction diverged
         inf = math.inf
-        return {"J": inf, "psi_rms_deg": inf, "r_rms_deg_s": inf, "k": float(fitted.n_params)}
-    e_psi = _wrap(sim[:, 2] - psi[split:])
+        return {"J": inf, "psi": inf, "r": inf, "k": float(fitted.n_params)}
+    e_psi = wrap(sim[:, 2] - psi[split:])
     e_r = sim[:, 4] - r[split:]
     n = e_psi.size
     rss_psi = max(float(e_psi @ e_psi), 1e-30)
@@ -548,14 +637,10 @@ def _score(
     J = n * math.log(rss_psi / n) + n * math.log(rss_r / n) + k * math.log(2 * n)
     return {
         "J": J,
-        "psi_rms_deg": math.degrees(math.sqrt(rss_psi / n)),
-        "r_rms_deg_s": math.degrees(math.sqrt(rss_r / n)),
+        "psi": math.sqrt(rss_psi / n),
+        "r": math.sqrt(rss_r / n),
         "k": float(fitted.n_params),
     }
-
-
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 # --------------------------------------------------------------------------------------------
@@ -568,63 +653,6 @@ def _record_speed(rec: Record) -> np.ndarray | None:
     if rec.u is not None:
         return rec.u if rec.v is None else np.hypot(rec.u, rec.v)
     return None
-
-
-def _window_starts(t: np.ndarray, window_s: float | None) -> np.ndarray:
-    """Start indices of consecutive windows of ``window_s`` seconds (one window if None).
-
-    A last window shorter than half ``window_s`` is merged into the one before.
-    """
-    if window_s is None:
-        return np.array([0])
-    edges = t[0] + window_s * np.arange(math.ceil((t[-1] - t[0]) / window_s))
-    starts = np.unique(np.searchsorted(t, edges - 1e-9 * window_s))
-    if starts.size > 1 and t[-1] - t[starts[-1]] < 0.5 * window_s:
-        starts = starts[:-1]
-    return starts
-
-
-def resolve_window(window_s: float | str | None, duration: float, base: str) -> float | None:
-    """The scoring window [s] for a record of ``duration`` seconds.
-
-    ``"auto"``: :data:`AUTO_WINDOW_S` for Nomoto-family records longer than
-    :data:`AUTO_WINDOW_DURATION`, none (whole-record free run) otherwise; for ``rvg3dof``
-    :data:`shipgym.sysid.rvg_identify.RVG_WINDOW_S`. A number must be positive.
-    """
-    if window_s == "auto":
-        if base == "rvg3dof":
-            from shipgym.sysid.rvg_identify import RVG_WINDOW_S
-
-            return RVG_WINDOW_S
-        return AUTO_WINDOW_S if duration > AUTO_WINDOW_DURATION else None
-    if window_s is None:
-        return None
-    if isinstance(window_s, bool) or not isinstance(window_s, int | float):
-        raise ValueError(f"window_s must be a number of seconds, 'auto' or None, got {window_s!r}")
-    if not (math.isfinite(window_s) and window_s > 0):
-        raise ValueError(f"window_s must be a positive number of seconds, got {window_s!r}")
-    return float(window_s)
-
-
-def _errors(
-    rec: Record, sim: dict[str, np.ndarray], sl: slice | np.ndarray = slice(None)
-) -> dict[str, float]:
-    """RMS errors of simulated channels against the record over the samples ``sl``.
-
-    ``sim`` maps channel names (``psi``, ``r`` and optionally ``x``, ``y``, ``u``) to
-    simulated series; shared by the Nomoto-family and the RVG reports.
-    """
-    e_psi = _wrap(sim["psi"][sl] - rec.psi[sl])
-    out = {
-        "psi_rms_deg": math.degrees(float(np.sqrt(np.mean(e_psi**2)))),
-        "r_rms_deg_s": math.degrees(float(np.sqrt(np.mean((sim["r"][sl] - rec.r[sl]) ** 2)))),
-    }
-    if "x" in sim:
-        d2 = (sim["x"][sl] - rec.x[sl]) ** 2 + (sim["y"][sl] - rec.y[sl]) ** 2
-        out["xy_rms_m"] = float(np.sqrt(np.mean(d2)))
-    if "u" in sim and rec.u is not None:
-        out["u_rms_m_s"] = float(np.sqrt(np.mean((sim["u"][sl] - rec.u[sl]) ** 2)))
-    return out
 
 
 def _report(
@@ -640,8 +668,8 @@ def _report(
     Whole record (``windowed`` False): one free run from the fit's estimated initial state.
     Windowed: each window starts from the measured ``psi``, ``r`` (read off a quadratic
     Savitzky-Golay fit over 11 samples, ``r'`` from its derivative for second-order models)
-    and position. Positions use the recorded speed and, for
-    the ``current`` effect, the drift ``(V_n, V_e)``.
+    and position. Positions use the recorded speed and, for the ``current`` effect, the drift
+    ``(V_n, V_e)``.
     """
     t = rec.time
     speed = _record_speed(rec)
@@ -678,6 +706,21 @@ def _report(
     return out
 
 
+def _traces(
+    rec: Record,
+    split: int,
+    starts: np.ndarray,
+    before: dict[str, np.ndarray],
+    after: dict[str, np.ndarray],
+) -> dict[str, Any]:
+    """The ``traces`` of the result (measured vs before vs after)."""
+    out: dict[str, Any] = {"time": rec.time, "split": split, "window_starts": starts}
+    for ch in ("psi", "r", "x", "y", "u"):
+        if ch in before and ch in after and getattr(rec, ch) is not None:
+            out[ch] = {"measured": getattr(rec, ch), "before": before[ch], "after": after[ch]}
+    return out
+
+
 # --------------------------------------------------------------------------------------------
 # current (positions)
 
@@ -691,15 +734,20 @@ def _dead_reckoning(t: np.ndarray, psi: np.ndarray, U: np.ndarray) -> tuple[np.n
 
 
 def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
-    """Drift velocity of the dead-reckoning position residual and its held-out score."""
+    """Drift velocity of the dead-reckoning position residual and its held-out score.
+
+    None without positions or a speed. Otherwise ``V_n``, ``V_e`` [m/s] (training fit),
+    ``speed``, ``direction`` [rad], ``t_stat``, ``delta_J`` (held-out BIC with minus without
+    drift), the held-out position RMS without/with drift: per axis ``x_rms_m_before`` ...
+    ``y_rms_m_after`` and both axes ``xy_rms_m_before``, ``xy_rms_m_after`` [m], and
+    ``V_full`` (the drift of a whole-record fit).
+    """
     if rec.x is None or rec.y is None:
         return None
-    t = rec.time
-    U = rec.U if rec.U is not None else None
+    U = _record_speed(rec)
     if U is None:
-        if rec.u is None:
-            return None
-        U = rec.u if rec.v is None else np.hypot(rec.u, rec.v)
+        return None
+    t = rec.time
     xn, ye = _dead_reckoning(t, rec.psi, U)
     ex, ey = rec.x - xn, rec.y - ye
     tr = t[:split]
@@ -707,6 +755,7 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
     out: dict[str, Any] = {}
     J = {}
     rms = {}
+    axis_rms: dict[bool, list[float]] = {}
     resid_train = []
     coefs = []
     for e in (ex, ey):
@@ -727,6 +776,7 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
             rss.append(max(float(res @ res), 1e-30))
         J[drift] = sum(n * math.log(s / n) for s in rss) + (2 * int(drift)) * math.log(2 * n)
         rms[drift] = math.sqrt(sum(rss) / (2 * n))
+        axis_rms[drift] = [math.sqrt(s / n) for s in rss]
     # standard error of the slope with the residual variance (white-noise assumption)
     se = []
     for res in resid_train:
@@ -743,6 +793,10 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
             "direction": float(math.atan2(V[1], V[0]) % (2 * math.pi)),
             "t_stat": t_stat,
             "delta_J": J[True] - J[False],
+            "x_rms_m_before": axis_rms[False][0],
+            "y_rms_m_before": axis_rms[False][1],
+            "x_rms_m_after": axis_rms[True][0],
+            "y_rms_m_after": axis_rms[True][1],
             "xy_rms_m_before": rms[False],
             "xy_rms_m_after": rms[True],
         }
@@ -756,29 +810,6 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
 
 # --------------------------------------------------------------------------------------------
 # residual diagnostics
-
-
-def _ljung_box(e: np.ndarray, lags: int) -> float:
-    e = e - e.mean()
-    n = e.size
-    d = float(e @ e)
-    if d <= 0:
-        return 0.0
-    q = 0.0
-    for k in range(1, min(lags, n - 1) + 1):
-        rho = float(e[k:] @ e[:-k]) / d
-        q += rho * rho / (n - k)
-    return n * (n + 2) * q
-
-
-def _xcorr(e: np.ndarray, u: np.ndarray, lag: int) -> float:
-    """Normalised cross-correlation of ``e(t)`` with ``u(t - lag)``."""
-    e = e - e.mean()
-    u = u - u.mean()
-    den = math.sqrt(float(e @ e) * float(u @ u))
-    if den <= 0 or lag >= e.size:
-        return 0.0
-    return float(e[lag:] @ u[: e.size - lag]) / den
 
 
 def residual_diagnostics(
@@ -808,18 +839,18 @@ def residual_diagnostics(
         ``signatures`` (effect -> ``{"coef", "r2"}``: least-squares fit of the r residual
         against the finite-difference sensitivity of the simulated r to the effect's
         parameter, the other parameters held: a diagnostic only, weak because a refit of
-        ``K`` and ``T`` absorbs much of each signature; the decision in :func:`identify` uses
-        the refitted candidates).
+        ``K`` and ``T`` absorbs much of each signature; the decision of
+        :func:`shipgym.sysid.engine.identify` uses the refitted candidates).
     """
     sim = replay(fit.model_name, fit.params, t, delta + fit.delta0, fit.x0)
-    e_psi = _wrap(sim[:, 2] - psi)
+    e_psi = wrap(sim[:, 2] - psi)
     e_r = r - sim[:, 4]
     out: dict[str, Any] = {
         "psi_rms_deg": math.degrees(float(np.sqrt(np.mean(e_psi**2)))),
         "r_rms_deg_s": math.degrees(float(np.sqrt(np.mean(e_r**2)))),
-        "ljung_box": _ljung_box(e_r, _LJUNG_BOX_LAGS),
+        "ljung_box": ljung_box(e_r, _LJUNG_BOX_LAGS),
         "ljung_box_lags": _LJUNG_BOX_LAGS,
-        "xcorr_delta": {lag: _xcorr(e_r, delta, lag) for lag in _XCORR_LAGS},
+        "xcorr_delta": {lag: xcorr(e_r, delta, lag) for lag in _XCORR_LAGS},
     }
     try:
         with warnings.catch_warnings():
@@ -836,7 +867,7 @@ def residual_diagnostics(
     names = {f.name for f in fields(p)}
     sig["rudder_offset"] = replay(fit.model_name, p, t, delta + fit.delta0 + 1e-3, fit.x0)[:, 4]
     sig["rudder_lag"] = replay(
-        fit.model_name, p, t, _lag_filter(t, delta, 2.0 * dt) + fit.delta0, fit.x0
+        fit.model_name, p, t, lag_filter(t, delta, 2.0 * dt) + fit.delta0, fit.x0
     )[:, 4]
     sig["input_delay"] = replay(
         fit.model_name, p, t, _shift(t, delta, 2.0 * dt) + fit.delta0, fit.x0
@@ -867,376 +898,271 @@ def residual_diagnostics(
 
 
 # --------------------------------------------------------------------------------------------
-# the loop
-
-
-def _jsonable(obj: Any) -> Any:
-    """Plain-Python copy of nested dicts/lists of numbers (NaN and inf become None)."""
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, bool | np.bool_):
-        return bool(obj)
-    if isinstance(obj, int | np.integer):
-        return int(obj)
-    if isinstance(obj, float | np.floating):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
+# the family
 
 
 @dataclass
-class IdentificationResult:
-    """Outcome of :func:`identify`.
+class _Context:
+    """One identification run: the record, its split and the caches of the candidates."""
 
-    Attributes
-    ----------
-    model : str
-        The base model (``"nomoto1"`` ... ``"rvg3dof"``).
-    base, final : object
-        Whole-record fits of the base and final models (:class:`FitResult` for the Nomoto
-        family, :class:`shipgym.sysid.rvg_identify.RVGFit` for ``rvg3dof``).
-    effects : list of dict
-        Accepted effects in order: ``{"name", "parameters", "evidence"}``; ``evidence`` holds the
-        held-out scores before/after, the BIC change and (``current``) the drift t statistic.
-    diagnostics : dict
-        Residual analysis of the base fit under ``"base"`` and of the final fit under
-        ``"final"`` (:func:`residual_diagnostics` for the Nomoto family).
-    parameters_before, parameters_after : dict
-        Estimated parameters of the base and final models (the effects' own parameters
-        ``T_d``, ``tau``, ``V_n``, ``V_e`` ... included).
-    error_before, error_after : dict
-        Simulation error of the base and final models over the whole record: ``psi_rms_deg``,
-        ``r_rms_deg_s`` and, where the record has them, ``xy_rms_m`` (RMS distance between the
-        simulated and recorded positions) and ``u_rms_m_s`` (RVG only: a Nomoto model takes the
-        recorded speed as input). With ``window_s`` the record is cut into consecutive windows,
-        each simulated from the measured state; otherwise one free run from the estimated
-        initial state.
-    window_s : float or None
-        Scoring window [s] (None: whole-record free run).
-    heldout : dict
-        ``from_s`` (start of the held-out part, seconds from the record start), ``error_before``
-        and ``error_after``: the same errors over the held-out part for the models fitted on
-        the training part only.
-    traces : dict
-        ``time``, ``split`` (first held-out index), ``window_starts`` (indices) and, per channel
-        (``psi``, ``r``, and ``x``, ``y``, ``u`` where present), ``{"measured", "before",
-        "after"}`` arrays of the whole-record simulations behind ``error_before/after``.
-    rounds : list of dict
-        Every candidate's score per round (for inspection).
-    runtime_s : float
-        Wall time.
-    """
-
-    model: str
-    base: Any
-    final: Any
-    effects: list[dict[str, Any]]
-    diagnostics: dict[str, Any]
-    parameters_before: dict[str, float]
-    parameters_after: dict[str, float]
-    error_before: dict[str, float]
-    error_after: dict[str, float]
-    window_s: float | None = None
-    heldout: dict[str, Any] = field(default_factory=dict)
-    traces: dict[str, Any] = field(default_factory=dict)
-    rounds: list[dict[str, Any]] = field(default_factory=list)
-    runtime_s: float = 0.0
+    record: Record
+    split: int
+    window_s: float | None
+    base_cfg: _Config
+    base_full: FitResult = field(init=False)
+    """Whole-record fit of the base (reported; its RMS are the noise levels ``sigma``)."""
+    y0: float = field(init=False)
+    sigma: tuple[float, float] = field(init=False)
+    cur_test: dict[str, Any] | None = field(init=False)
+    memo: dict[Any, tuple[float, FitResult]] = field(default_factory=dict)
+    tried: dict[_Config, tuple[_Fitted, dict[str, float]] | Exception] = field(default_factory=dict)
 
     @property
-    def effect_names(self) -> list[str]:
-        """Names of the accepted effects, in order."""
-        return [e["name"] for e in self.effects]
+    def train(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        rec, tr = self.record, slice(0, self.split)
+        return rec.time[tr], rec.delta[tr], rec.psi[tr], rec.r[tr]
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready summary (the ``shipgym identify --json`` document).
-
-        Keys: ``model``, ``parameters_before``, ``error_before``, ``effects`` (``{name,
-        parameters, evidence}`` in order), ``parameters``, ``error_after``, ``window_s``,
-        ``heldout``, ``rounds``, ``runtime_s``. Non-finite numbers become ``null``.
-        """
-        return _jsonable(
-            {
-                "model": self.model,
-                "parameters_before": self.parameters_before,
-                "error_before": self.error_before,
-                "effects": self.effects,
-                "parameters": self.parameters_after,
-                "error_after": self.error_after,
-                "window_s": self.window_s,
-                "heldout": self.heldout,
-                "rounds": self.rounds,
-                "runtime_s": self.runtime_s,
-            }
-        )
+    def score(self, fitted: _Fitted) -> dict[str, float]:
+        rec = self.record
+        return _score(fitted, rec.time, rec.delta, rec.psi, rec.r, self.split, self.sigma)
 
 
-def identify(
-    record: Record,
-    base: str = "nomoto1",
-    *,
-    holdout: float = 0.3,
-    max_effects: int = 3,
-    window_s: float | str | None = "auto",
-    progress: Callable[[str], None] | None = None,
-) -> IdentificationResult:
-    """Fit a base model, then add catalogue effects while the held-out score improves.
+class NomotoFamily(ModelFamily):
+    """A Nomoto-family base and its effect catalogue (module docstring).
 
     Parameters
     ----------
-    record : Record
-        A manoeuvre record (``time``, ``delta``, ``psi``, ``r``; ``x``, ``y`` and ``U`` or
-        ``u`` enable the ``current`` candidate; ``rvg3dof`` needs ``rpm`` and positions and
-        speeds, as in the Gunnerus sea trials).
-    base : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof"}
-        Base model. A base that already has an effect's term (``nomoto2``: ``second_order``,
-        ``norrbin``: ``yaw_nonlinearity``, ``bech``: both) does not offer it as a candidate.
-        ``rvg3dof`` runs :func:`shipgym.sysid.rvg_identify.identify_rvg`.
-    holdout : float
-        Fraction of the record (its end) kept out of the fits and used for scoring, in
-        ``[0.1, 0.6]``.
-    max_effects : int
-        Largest number of effects to add (>= 0).
-    window_s : float, "auto" or None
-        Report errors over consecutive windows of this many seconds, each simulated from the
-        measured state (:func:`resolve_window` for ``"auto"``); None: one free run.
-    progress : callable, optional
-        Called with a one-line message per candidate.
-
-    Returns
-    -------
-    IdentificationResult
-
-    Raises
-    ------
-    ValueError
-        For a bad ``base``, ``holdout``, ``max_effects`` or ``window_s``, or a record too short
-        to split or lacking the channels the base needs.
+    base : {"nomoto1", "nomoto2", "norrbin", "bech"}
+        The base yaw model.
     """
-    t_start = time.perf_counter()
-    if not isinstance(record, Record):
-        raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(record).__name__}")
-    if base not in BASES:
-        raise ValueError(f"unsupported base {base!r}; expected one of {BASES}")
-    if not (isinstance(holdout, int | float) and 0.1 <= float(holdout) <= 0.6):
-        raise ValueError(f"holdout must be a fraction in [0.1, 0.6], got {holdout!r}")
-    if not (isinstance(max_effects, int) and max_effects >= 0):
-        raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
-    t, delta, psi, r = record.time, record.delta, record.psi, record.r
-    window = resolve_window(window_s, float(t[-1] - t[0]), base)
-    if base == "rvg3dof":
-        from shipgym.sysid.rvg_identify import identify_rvg
 
-        return identify_rvg(
-            record,
-            holdout=float(holdout),
-            max_effects=max_effects,
-            window_s=window,
-            progress=progress,
-        )
-    n = t.size
-    split = round(n * (1.0 - float(holdout)))
-    if split < 40 or n - split < 20:
-        raise ValueError(
-            f"record too short to split: {n} samples give {split} training and {n - split} "
-            "held-out samples (need >= 40 and >= 20)"
-        )
-    say = progress or (lambda _msg: None)
+    min_relative_drop = MIN_RELATIVE_DROP
+    default_window_s = None
 
-    # base fit on the whole record (reported) and on the training part (scored)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SysidWarning)
-        base_full = fit_output_error(t, delta, psi, r, base)
-    tr = slice(0, split)
-    y0 = _initial_rudder(base_full, t, r)
-    cfg = _Config(**_BASE_CONFIG[base])
-    sigma = (max(base_full.rms_psi, 1e-6), max(base_full.rms_r, 1e-9))
-    memo: dict[Any, tuple[float, FitResult]] = {}
-    tried: dict[_Config, tuple[_Fitted, dict[str, float]] | Exception] = {}
-    current_fit = _fit_config(cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None)
-    current_score = base_score = _score(current_fit, t, delta, psi, r, split, sigma)
-    say(f"base {base}: held-out psi {current_score['psi_rms_deg']:.3f} deg")
-    cur_test = _current_test(record, split)
-    effects: list[dict[str, Any]] = []
-    rounds: list[dict[str, Any]] = []
-    current_added = False
-    yaw_effects = [e for e in NOMOTO_CATALOGUE if e != "current"]
-    while len(effects) < max_effects:
-        candidates: dict[str, dict[str, Any]] = {}
-        for name in yaw_effects:
-            if cfg.with_effect(name) == cfg:  # already in the model (base or accepted)
-                continue
-            new_cfg = cfg.with_effect(name)
-            try:
-                if new_cfg not in tried:  # (accepting current leaves the yaw model as it was)
-                    try:
-                        fitted = _fit_config(
-                            new_cfg, t[tr], delta[tr], psi[tr], r[tr], sigma, None, y0, memo
-                        )
-                        tried[new_cfg] = (fitted, _score(fitted, t, delta, psi, r, split, sigma))
-                    except (ValueError, TypeError, np.linalg.LinAlgError) as exc:
-                        tried[new_cfg] = exc
-                outcome = tried[new_cfg]
-                if isinstance(outcome, Exception):
-                    raise outcome
-                fitted, sc = outcome[0], dict(outcome[1])
-            except (ValueError, TypeError, np.linalg.LinAlgError) as exc:
-                say(f"  {name}: fit failed ({exc})")
-                candidates[name] = {
-                    "delta_J": math.inf,
-                    "relative_drop": -math.inf,
-                    "significant": False,
-                    "error": str(exc),
-                }
-                continue
-            if not math.isfinite(sc["J"]):  # failed fit or diverging prediction
-                dJ, drop = math.inf, -math.inf
-            else:  # (a diverging current model makes any finite candidate an improvement)
-                dJ = sc["J"] - current_score["J"]
-                drop = 1.0 - sc["psi_rms_deg"] / current_score["psi_rms_deg"]
-            ok = dJ < -BIC_MARGIN and drop > MIN_RELATIVE_DROP
-            candidates[name] = {
-                "fitted": fitted,
-                "score": sc,
-                "delta_J": dJ,
-                "relative_drop": drop,
-                "significant": ok,
-            }
-            say(f"  {name}: dJ {dJ:.1f}, psi drop {100 * drop:.1f} %, significant {ok}")
-        if cur_test is not None and not current_added:
-            drop = 1.0 - cur_test["xy_rms_m_after"] / max(cur_test["xy_rms_m_before"], 1e-12)
-            ok = (
-                cur_test["delta_J"] < -BIC_MARGIN
-                and drop > MIN_RELATIVE_DROP
-                and cur_test["t_stat"] > CURRENT_T_MIN
+    def __init__(self, base: str) -> None:
+        if base not in NOMOTO_BASES:
+            raise ValueError(f"unsupported Nomoto-family base {base!r}; expected {NOMOTO_BASES}")
+        self.name = base
+        self.catalogue = _catalogue(base)
+
+    def resolve_window(self, window_s: float | str | None, duration: float) -> float | None:
+        """``"auto"``: :data:`AUTO_WINDOW_S` for records longer than
+        :data:`AUTO_WINDOW_DURATION` [s], none (one free run) otherwise."""
+        if window_s == "auto":
+            return AUTO_WINDOW_S if duration > AUTO_WINDOW_DURATION else None
+        return super().resolve_window(window_s, duration)
+
+    def prepare(self, record: Record, holdout: float, window_s: float | None) -> _Context:
+        """Split ``record`` (``ValueError`` if the parts have fewer than 40 / 20 samples)."""
+        n = record.time.size
+        split = round(n * (1.0 - holdout))
+        if split < 40 or n - split < 20:
+            raise ValueError(
+                f"record too short to split: {n} samples give {split} training and {n - split} "
+                "held-out samples (need >= 40 and >= 20)"
             )
-            candidates["current"] = {
-                "delta_J": cur_test["delta_J"],
-                "relative_drop": drop,
-                "significant": ok,
-                "test": cur_test,
-            }
-            say(f"  current: dJ {cur_test['delta_J']:.1f}, t {cur_test['t_stat']:.1f}, {ok}")
-        rounds.append(
-            {
-                k: {kk: vv for kk, vv in v.items() if kk not in ("fitted", "test")}
-                | ({"score": v["score"]} if "score" in v else {})
-                for k, v in candidates.items()
-            }
-        )
-        good = {k: v for k, v in candidates.items() if v["significant"]}
-        if not good:
-            break
-        best = min(good, key=lambda k: good[k]["delta_J"])
-        # parsimony: among candidates within TIE_FRACTION of the best BIC change, the one with
-        # the fewest added parameters (the correlated residual makes small differences moot)
-        tied = [
-            k for k in good if good[k]["delta_J"] <= (1.0 - TIE_FRACTION) * good[best]["delta_J"]
-        ]
-        best = min(tied, key=lambda k: (_N_ADDED[k], good[k]["delta_J"]))
+        return _Context(record, split, window_s, _Config.of_base(self.name))
+
+    def _candidate(
+        self, ctx: _Context, effects: tuple[str, ...], fitted: _Fitted, sc: Mapping[str, float]
+    ) -> Candidate:
+        rms = {"psi": sc["psi"], "r": sc["r"]}
+        test = ctx.cur_test
+        if test is not None:  # the dead reckoning, with the drift once current is in
+            after = "after" if fitted.drift is not None else "before"
+            rms.update(x=test[f"x_rms_m_{after}"], y=test[f"y_rms_m_{after}"])
+        return Candidate(effects, fitted, sc["J"], sc["psi"], rms, {"J": sc["J"], "k": sc["k"]})
+
+    def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
+        """The base fitted on the training part; also the whole-record fit of the base, the
+        noise levels of the training fits, the gear's initial angle and the drift test."""
+        rec = ctx.record
+        t, delta, psi, r = rec.time, rec.delta, rec.psi, rec.r
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SysidWarning)
+            ctx.base_full = fit_output_error(t, delta, psi, r, self.name)
+        ctx.y0 = _initial_rudder(ctx.base_full, t, r)
+        ctx.sigma = (max(ctx.base_full.rms_psi, 1e-6), max(ctx.base_full.rms_r, 1e-9))
+        fitted = _fit_config(ctx.base_cfg, *ctx.train, ctx.sigma, None)
+        ctx.cur_test = _current_test(rec, ctx.split)
+        fitted.positions = ctx.cur_test is not None
+        return self._candidate(ctx, (), fitted, ctx.score(fitted))
+
+    def candidates(self, current: Candidate) -> Iterable[str]:
+        """The yaw effects not in the model, then ``current`` (with positions, once)."""
+        cfg = current.fitted.config
+        names = [e for e in self.catalogue if e != "current" and cfg.with_effect(e) != cfg]
+        if "current" in self.catalogue and current.fitted.positions:
+            if current.fitted.drift is None:
+                names.append("current")
+        return names
+
+    def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
+        """``current`` plus ``name``, fitted on the training part and scored (yaw effects:
+        every configuration is fitted once per record; ``current``: the drift test)."""
+        now: _Fitted = current.fitted
+        effects = (*current.effects, name)
+        if name == "current":
+            test = ctx.cur_test
+            if test is None:
+                raise ValueError("current needs positions and a speed")
+            rms = {**current.heldout_rms, "x": test["x_rms_m_after"], "y": test["y_rms_m_after"]}
+            # J: the yaw score plus the position score's change (both log-likelihoods)
+            return Candidate(
+                effects,
+                replace(now, drift=test["V_full"]),
+                current.J + test["delta_J"],
+                test["xy_rms_m_after"],
+                rms,
+                {"drift_test": test, "evidence_t_stat": test["t_stat"]},
+            )
+        cfg = now.config.with_effect(name)
+        if cfg not in ctx.tried:  # (accepting current leaves the yaw model as it was)
+            try:
+                fitted = _fit_config(cfg, *ctx.train, ctx.sigma, None, ctx.y0, ctx.memo)
+                ctx.tried[cfg] = (fitted, ctx.score(fitted))
+            except _FIT_ERRORS as exc:
+                ctx.tried[cfg] = exc
+        outcome = ctx.tried[cfg]
+        if isinstance(outcome, TypeError):
+            raise ValueError(str(outcome)) from outcome
+        if isinstance(outcome, Exception):
+            raise outcome
+        fitted = replace(outcome[0], drift=now.drift, positions=now.positions)
+        return self._candidate(ctx, effects, fitted, outcome[1])
+
+    def compare(self, current: Candidate, cand: Candidate, name: str) -> tuple[float, float]:
+        """``current``: the position score of the drift test (its BIC change and the drop of
+        the held-out position RMS); the yaw effects: the engine's rule."""
+        if name == "current":
+            test = cand.extra["drift_test"]
+            drop = 1.0 - test["xy_rms_m_after"] / max(test["xy_rms_m_before"], 1e-12)
+            return float(test["delta_J"]), drop
+        return super().compare(current, cand, name)
+
+    def significant(self, cand: Candidate, name: str, delta_j: float, drop: float) -> bool:
+        """The engine's rule; ``current`` also needs a drift t statistic above
+        :data:`CURRENT_T_MIN`."""
+        ok = super().significant(cand, name, delta_j, drop)
+        if name == "current":
+            ok = ok and cand.extra["evidence_t_stat"] > CURRENT_T_MIN
+        return ok
+
+    def choose(self, good: Mapping[str, tuple[Candidate, float]]) -> str:
+        """The engine's parsimony rule, then ``second_order`` with ``|T3| <
+        LAG_EQUIVALENT_T3 * T2`` reads as ``rudder_lag`` when that is significant too."""
+        best = super().choose(good)
         if best == "second_order" and "rudder_lag" in good:
-            v = good["second_order"]["fitted"].fit.values
+            v = good["second_order"][0].fitted.fit.values
             if abs(v["T3"]) < LAG_EQUIVALENT_T3 * v["T2"]:
                 # K / ((1 + T1 s)(1 + T2 s)) with no zero is the base model behind a rudder lag
                 # T_d = T2: prefer the explanation with one parameter fewer
-                say(f"second_order has T3 = {v['T3']:.3g} s ~ 0: read as rudder_lag")
                 best = "rudder_lag"
-        c = good[best]
-        if best == "current":
-            test = c["test"]
-            effects.append(
-                {
-                    "name": "current",
-                    "parameters": {
-                        "V_n": test["V_full"][0],
-                        "V_e": test["V_full"][1],
-                        "speed": math.hypot(*test["V_full"]),
-                    },
-                    "evidence": {
-                        "delta_J": c["delta_J"],
-                        "t_stat": test["t_stat"],
-                        "heldout_xy_rms_m_before": test["xy_rms_m_before"],
-                        "heldout_xy_rms_m_after": test["xy_rms_m_after"],
-                    },
-                }
+        return best
+
+    def accept(self, ctx: _Context, current: Candidate, cand: Candidate, name: str) -> Candidate:
+        """``current`` keeps the yaw model and its held-out score and adds the drift."""
+        if name == "current":
+            return Candidate(
+                cand.effects, cand.fitted, current.J, current.heldout_error, cand.heldout_rms
             )
-            current_added = True
-        else:
-            fitted = c["fitted"]
-            evidence = {
-                "delta_J": c["delta_J"],
-                "heldout_psi_rms_deg_before": current_score["psi_rms_deg"],
-                "heldout_psi_rms_deg_after": c["score"]["psi_rms_deg"],
-                "heldout_r_rms_deg_s_before": current_score["r_rms_deg_s"],
-                "heldout_r_rms_deg_s_after": c["score"]["r_rms_deg_s"],
+        return cand
+
+    def effect_parameters(self, fitted: _Fitted, name: str) -> dict[str, float]:
+        """The effect's parameters (SI, radians): ``delta0`` (also derived from ``n0``/``b0``),
+        ``n1..n3`` or ``b1..b3``, ``T1..T3``, ``T_d``, ``tau``, ``V_n``, ``V_e`` with
+        ``speed`` and ``direction`` (towards, clockwise from north)."""
+        v = fitted.parameters()
+        if name == "rudder_offset":
+            if "n0" in v:
+                return {"n0": v["n0"], "delta0": -v["n0"] / v["K"] if v["K"] else math.nan}
+            if "b0" in v:
+                return {"b0": v["b0"], "delta0": -v["b0"]}
+            return {"delta0": v["delta0"]}
+        if name == "yaw_nonlinearity":
+            c = "b" if "b1" in v else "n"
+            return {f"{c}{i}": v[f"{c}{i}"] for i in (1, 2, 3)}
+        if name == "second_order":
+            return {k: v[k] for k in ("T1", "T2", "T3")}
+        if name == "rudder_lag":
+            return {"T_d": v["T_d"]}
+        if name == "input_delay":
+            return {"tau": v["tau"]}
+        if name == "current":
+            if fitted.drift is None:
+                raise ValueError("the model has no current")
+            vn, ve = fitted.drift
+            return {
+                "V_n": vn,
+                "V_e": ve,
+                "speed": math.hypot(vn, ve),
+                "direction": math.atan2(ve, vn) % (2.0 * math.pi),
             }
-            cfg, current_fit, current_score = fitted.config, fitted, c["score"]
-            effects.append({"name": best, "parameters": fitted.parameters(), "evidence": evidence})
-        say(f"accepted {best}")
+        raise ValueError(f"unknown effect {name!r} of {self.name}")
 
-    # final fit on the whole record
-    if cfg == _Config(**_BASE_CONFIG[base]) and not cfg.nonlinear:
-        final = _Fitted(cfg, base_full)  # the same fit (the nonlinear bases start differently)
-    else:
-        final = _fit_config(cfg, t, delta, psi, r, sigma, None, y0, memo)
-    d_final = _input(cfg, t, delta, final.T_d, final.tau, y0)
-    diagnostics = {
-        "base": residual_diagnostics(base_full, t, delta, psi, r),
-        "final": residual_diagnostics(final.fit, t, d_final, psi, r),
-    }
-    params_before = {
-        k: float(v) for k, v in base_full.values.items() if k not in ("psi0", "r0", "r_dot0")
-    }
-    params_after = final.parameters()
-    drift = (0.0, 0.0)
-    if current_added:
-        assert cur_test is not None
-        drift = cur_test["V_full"]
-        params_after["V_n"], params_after["V_e"] = drift
-    starts = _window_starts(t, window)
-    sim_before = _report(base_full, delta, record, starts, window is not None)
-    sim_after = _report(final.fit, d_final, record, starts, window is not None, drift)
-    # update the accepted yaw effects' parameters to the whole-record fit
-    for e in effects:
-        if e["name"] == "rudder_lag":
-            e["parameters"]["T_d"] = params_after["T_d"]
-        elif e["name"] == "input_delay":
-            e["parameters"]["tau"] = params_after["tau"]
-    heldout = {
-        "from_s": float(t[split] - t[0]),
-        "error_before": {k: base_score[k] for k in ("psi_rms_deg", "r_rms_deg_s")},
-        "error_after": {k: current_score[k] for k in ("psi_rms_deg", "r_rms_deg_s")},
-    }
-    return IdentificationResult(
-        model=base,
-        base=base_full,
-        final=final.fit,
-        effects=effects,
-        diagnostics=diagnostics,
-        parameters_before=params_before,
-        parameters_after=params_after,
-        error_before=_errors(record, sim_before),
-        error_after=_errors(record, sim_after),
-        window_s=window,
-        heldout=heldout,
-        traces=_traces(record, split, starts, sim_before, sim_after),
-        rounds=rounds,
-        runtime_s=time.perf_counter() - t_start,
-    )
+    def finish(
+        self, ctx: _Context, base: Candidate, final: Candidate, say: Callable[[str], None]
+    ) -> dict[str, Any]:
+        """Whole-record fit of the final model, errors, diagnostics and traces."""
+        rec = ctx.record
+        t, delta, psi, r = rec.time, rec.delta, rec.psi, rec.r
+        cfg = final.fitted.config
+        if cfg == ctx.base_cfg and not cfg.nonlinear:
+            # no yaw effect: the base's whole-record fit (_fit_config starts a nonlinear base
+            # from its linear part, fit_output_error does not)
+            full = _Fitted(cfg, ctx.base_full)
+        else:
+            say("whole-record fit of the final model")
+            full = _fit_config(cfg, t, delta, psi, r, ctx.sigma, None, ctx.y0, ctx.memo)
+        full.drift = final.fitted.drift
+        d_final = _input(cfg, t, delta, full.T_d, full.tau, ctx.y0)
+        diagnostics = {
+            "base": residual_diagnostics(ctx.base_full, t, delta, psi, r),
+            "final": residual_diagnostics(full.fit, t, d_final, psi, r),
+        }
+        params_before = {
+            k: float(v) for k, v in ctx.base_full.values.items() if k not in _INITIAL_STATE
+        }
+        params_after = full.parameters()
+        drift = (0.0, 0.0)
+        if full.drift is not None:
+            drift = full.drift
+            params_after["V_n"], params_after["V_e"] = drift
+        starts = window_starts(t, ctx.window_s)
+        windowed = ctx.window_s is not None
+        sim_before = _report(ctx.base_full, delta, rec, starts, windowed)
+        sim_after = _report(full.fit, d_final, rec, starts, windowed, drift)
+        heldout = {
+            "from_s": float(t[ctx.split] - t[0]),
+            "error_before": _heldout_errors(base),
+            "error_after": _heldout_errors(final),
+        }
+        return {
+            "base": ctx.base_full,
+            "final": full.fit,
+            "diagnostics": diagnostics,
+            "parameters_before": params_before,
+            "parameters_after": params_after,
+            "error_before": errors(rec, sim_before),
+            "error_after": errors(rec, sim_after),
+            "heldout": heldout,
+            "traces": _traces(rec, ctx.split, starts, sim_before, sim_after),
+            # the input filters' constants of the whole-record fit
+            "effect_parameters": {
+                e: self.effect_parameters(full, e)
+                for e in final.effects
+                if e in ("rudder_lag", "input_delay")
+            },
+        }
 
 
-def _traces(
-    rec: Record,
-    split: int,
-    starts: np.ndarray,
-    before: dict[str, np.ndarray],
-    after: dict[str, np.ndarray],
-) -> dict[str, Any]:
-    """The ``traces`` of :class:`IdentificationResult` (measured vs before vs after)."""
-    out: dict[str, Any] = {"time": rec.time, "split": split, "window_starts": starts}
-    for ch in ("psi", "r", "x", "y", "u"):
-        if ch in before and ch in after and getattr(rec, ch) is not None:
-            out[ch] = {"measured": getattr(rec, ch), "before": before[ch], "after": after[ch]}
-    return out
+def _heldout_errors(cand: Candidate) -> dict[str, float]:
+    """Held-out ``psi_rms_deg``, ``r_rms_deg_s`` of a candidate."""
+    return {
+        "psi_rms_deg": math.degrees(cand.heldout_rms["psi"]),
+        "r_rms_deg_s": math.degrees(cand.heldout_rms["r"]),
+    }
+
+
+for _base in NOMOTO_BASES:
+    register(NomotoFamily(_base))
