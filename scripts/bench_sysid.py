@@ -1,4 +1,4 @@
-"""Speed of the system identification against the goals of issue 4 (a benchmark, not a test).
+"""Speed of the system identification against its speed goals (a benchmark, not a test).
 
 Usage::
 

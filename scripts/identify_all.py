@@ -1,4 +1,4 @@
-"""Identify every measured record; JSON, Markdown report, figures and the README table (issue 4).
+"""Identify every measured record; JSON, Markdown report, figures and the README table.
 
 Usage::
 

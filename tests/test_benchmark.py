@@ -1,4 +1,4 @@
-"""``shipgym benchmark`` and ``shipgym train`` (issue 5, sections 1 and 3).
+"""``shipgym benchmark`` and ``shipgym train``.
 
 The benchmark on identical seeds and current draws for every controller, the stress condition,
 its JSON/CSV/figures and the seed guard; the PPO throughput measurement; the command lines and

@@ -618,9 +618,44 @@ def test_rvg_straight_line_speed_at_service_thrust() -> None:
     assert np.all(np.diff(res["u"]) >= 0.0)
 
 
+def test_rvg_wave_resistance_is_the_froude_scaled_drag() -> None:
+    """``R_w = c_w Fn^2 rho/2 S u^2``: the straight run settles where the thrust balances the
+    seed's drag plus this term, and the term acts on surge only, as ``|u| u^3``."""
+    from shipgym.models.rvg import GRAVITY, LPP, WATER_DENSITY, WETTED_SURFACE
+
+    params = RVGParams(wave_resistance=0.04)
+    model = make_model("rvg3dof", params)
+    thrust = params.service_thrust
+    res = model.simulate(RVG_X0_ZERO, np.tile([thrust, thrust, 0.0, 0.0], (3000, 1)), 0.2)
+    u = res["u"][-1]
+    fn2 = u * u / (GRAVITY * LPP)
+    drag = (
+        params.linear_damping[0, 0] * u
+        + params.surge_quadratic_damping * u * u
+        + 0.04 * fn2 * 0.5 * WATER_DENSITY * WETTED_SURFACE * u * u
+    )
+    assert drag == pytest.approx(2.0 * thrust, rel=1e-6)
+    assert u < _rvg_straight_run_at_service_thrust()[1]["u"][-1] - 0.05
+    seed = make_model("rvg3dof")
+    for uu in (-3.0, 0.0, 2.0, 6.0):
+        x = np.array([0.0, 0.0, 0.0, uu, 0.4, 0.03, 0.0, 0.0, 0.0, 0.0])
+        f = (
+            params.mass_matrix
+            @ (model.deriv(x, [0, 0, 0, 0]) - seed.deriv(x, [0, 0, 0, 0]))[0, 3:6]
+        )
+        r_w = 0.04 * WATER_DENSITY * WETTED_SURFACE / (2 * GRAVITY * LPP) * abs(uu) * uu**3
+        np.testing.assert_allclose(f, [-r_w, 0.0, 0.0], atol=1e-6 * abs(r_w) + 1e-9)
+
+
 def test_rvg_service_thrust_holds_documented_service_speed() -> None:
     _, res = _rvg_straight_run_at_service_thrust()
     assert res["u"][-1] == pytest.approx(5.144, rel=5e-3)
+    # the sea-trial set carries its own service thrust, which holds the same speed
+    sea = make_model("rvg3dof", "sea_trials")
+    thrust = sea.params.service_thrust
+    assert thrust != pytest.approx(25.0e3, rel=0.05)
+    res = sea.simulate(RVG_X0_ZERO, np.tile([thrust, thrust, 0.0, 0.0], (3000, 1)), 0.2)
+    assert res["u"][-1] == pytest.approx(5.144, rel=1e-3)
 
 
 # --------------------------------------------------------------------------------------------

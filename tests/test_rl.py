@@ -1,4 +1,4 @@
-"""RL training and the shipped agents (issue 5, sections 1, 2 and 4).
+"""RL training and the shipped agents.
 
 The SB3 adapter's same-step autoreset against single envs, tiny ``learn(64)``-sized trainings
 of PPO and SAC on every env (through :func:`shipgym.rl.train.train`, which also saves and

@@ -116,7 +116,7 @@ def test_current_named_with_positions() -> None:
     assert p["speed"] == pytest.approx(math.hypot(p["V_n"], p["V_e"]))
     assert res.error_after["xy_rms_m"] <= 0.5 * res.error_before["xy_rms_m"]
     ev = res.effects[0]["evidence"]
-    assert ev["evidence_t_stat"] > 5.0
+    assert ev["t_stat"] > 5.0
     # the yaw model is unchanged; the held-out dead-reckoning positions improve
     assert ev["heldout_rms_after"]["psi"] == ev["heldout_rms_before"]["psi"]
     assert ev["heldout_rms_after"]["x"] < ev["heldout_rms_before"]["x"]

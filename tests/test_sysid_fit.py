@@ -1,4 +1,4 @@
-"""Identification against known truth: equation error, output error, RLS, backstepping (issue 4)."""
+"""Identification against known truth: equation error, output error, RLS, backstepping."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tests of the identification report over many records (shipgym.sysid.report, issue 4)."""
+"""Tests of the identification report over many records (shipgym.sysid.report)."""
 
 from __future__ import annotations
 

@@ -54,16 +54,17 @@ def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
     xi = x[i]
     ui = u[i]
     ci = c[i]
-    row_rhs(model_id, xi, ui, p, ci, k1)
     for j in range(m):
-        t[j] = xi[j] + 0.5 * h * k1[j]
-    row_rhs(model_id, t, ui, p, ci, k2)
-    for j in range(m):
-        t[j] = xi[j] + 0.5 * h * k2[j]
-    row_rhs(model_id, t, ui, p, ci, k3)
-    for j in range(m):
-        t[j] = xi[j] + h * k3[j]
-    row_rhs(model_id, t, ui, p, ci, k4)
+        t[j] = xi[j]
+    # one call site for the four stages: the derivative is inlined once, not four times
+    # (compile time and code size grow with every inlined copy of every model)
+    for s in range(4):
+        k = k1 if s == 0 else k2 if s == 1 else k3 if s == 2 else k4
+        row_rhs(model_id, t, ui, p, ci, k)
+        if s < 3:
+            a = h if s == 2 else 0.5 * h
+            for j in range(m):
+                t[j] = xi[j] + a * k[j]
     for j in range(m):
         xi[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 

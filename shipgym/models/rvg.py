@@ -57,6 +57,12 @@ over the hull (``x`` from the aft to the forward perpendicular) less its pure ``
 ``Y_|v|r``, ``Y_|r|v``, ``N_|v|v``, ``N_|r|v`` ... that couple sway and yaw. ``C_cf = 0`` in
 seed 001.
 
+Wave-making resistance (Molland, Turnock and Hudson 2017, ch. 4): the seed's surge drag
+``X_u u + X_|u|u |u| u`` grows as ``u^2``; a ship of 34 m at 3.5-6.5 m/s runs at Froude numbers
+``Fn = u / sqrt(g L)`` of 0.2-0.36, where the wave resistance coefficient rises about as
+``Fn^2``. The term ``R_w = c_w Fn^2 rho/2 S u_r^2 = c_w rho S |u_r| u_r^3 / (2 g L)`` with the
+wetted surface ``S`` of Denny and Mumford (``WETTED_SURFACE``) adds it (``c_w = 0`` in seed 001).
+
 State ``[x, y, psi, u, v, r, T_1, T_2, alpha_1, alpha_2]`` in [m, m, rad, m/s, m/s, rad/s, N, N,
 rad, rad]; input ``[T_1c, T_2c, alpha_1c, alpha_2c]``. Pod 1 is port (y < 0), pod 2 starboard.
 
@@ -68,7 +74,7 @@ symmetric ``M`` the kinetic energy relative to the water, ``nu_r^T M nu_r / 2``,
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -98,6 +104,11 @@ table (``scripts/pod_fmu_fit.py``)."""
 POD_SLIPSTREAM_FMU = 0.153
 """``k_s`` [-] of the same fit: the fraction of the far-wake slipstream dynamic pressure the
 strut sees (the thruster_lift effect keeps it fixed and fits ``c_L``)."""
+
+GRAVITY = 9.81  # [m/s^2]
+WETTED_SURFACE = 1.7 * LPP * DRAUGHT + 574_127.69 / WATER_DENSITY / DRAUGHT
+"""Wetted hull surface ``S`` [m^2] by Denny and Mumford's formula ``1.7 L T + V / T`` (363 m^2;
+Molland, Turnock and Hudson 2017, ch. 10), the area of the wave-making resistance term."""
 
 #: Gauss-Legendre nodes and weights on [-1, 1] for the cross-flow drag integral over the hull.
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
@@ -196,6 +207,10 @@ class RVGParams:
         ``X_vv`` [kg/m], ``X_vr`` [kg], ``X_rr`` [kg m] of the turning speed loss (0 in seed 001).
     crossflow_coefficient : float
         ``C_cf`` [-], the cross-flow drag coefficient of the sway-yaw cross terms (0 in seed 001).
+    wave_resistance : float
+        ``c_w`` [-] of the wave-making resistance ``R_w = c_w Fn^2 rho/2 S u_r^2`` with
+        ``Fn = u_r / sqrt(g L)`` (0 in seed 001): the resistance that rises faster than ``u^2``
+        from Froude number 0.2 on (the trials run at 0.20-0.34).
     name : str
         Name of the parameter set (``"seed001"``; :meth:`sea_trials` gives ``"sea_trials"``).
     """
@@ -233,6 +248,7 @@ class RVGParams:
     surge_vr: float = 0.0
     surge_rr: float = 0.0
     crossflow_coefficient: float = 0.0
+    wave_resistance: float = 0.0
     name: str = "seed001"
 
     def __post_init__(self) -> None:
@@ -257,7 +273,12 @@ class RVGParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
-        for name in ("pod_lift_coefficient", "pod_slipstream", "crossflow_coefficient"):
+        for name in (
+            "pod_lift_coefficient",
+            "pod_slipstream",
+            "crossflow_coefficient",
+            "wave_resistance",
+        ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"RVGParams.{name} must be a finite number >= 0, got {value!r}")
@@ -277,21 +298,36 @@ class RVGParams:
     def sea_trials(cls) -> RVGParams:
         """The parameter set identified from the Gunnerus sea trials (``SEA_TRIALS_VALUES``).
 
-        Seed 001's model with the pod normal force (``c_L`` 3.82e3, slipstream fraction
-        ``POD_SLIPSTREAM_FMU``) and the calibrated guesses of the seed within their documented
-        ranges (README, "The real Gunnerus", and docs/gunnerus.md for the manoeuvres).
+        Seed 001's model with the effects the identification loop named (pod normal force with
+        slipstream fraction ``POD_SLIPSTREAM_FMU``, wave-making resistance, thrust deduction and
+        wake fraction) and the calibrated guesses of the seed within their documented ranges
+        (README, "The real Gunnerus", and docs/gunnerus.md for the manoeuvres). Its
+        ``service_thrust`` is the pod thrust that holds the service speed in this set
+        (:meth:`straight_resistance`).
         """
         v = SEA_TRIALS_VALUES
         seed = cls()
         dl = seed.linear_damping.copy()
         dl[1, 1] = v["sway_linear_damping"]
         dl[2, 2] = v["yaw_linear_damping"]
-        return cls(
+        fitted = cls(
             linear_damping=dl,
             pod_slipstream=POD_SLIPSTREAM_FMU,
             name="sea_trials",
             **{k: val for k, val in v.items() if not k.endswith("_linear_damping")},
         )
+        thrust = fitted.straight_resistance(SERVICE_SPEED) / (2.0 * (1.0 - fitted.thrust_deduction))
+        return replace(fitted, service_thrust=thrust)
+
+    def straight_resistance(self, u: float) -> float:
+        """Surge resistance [N] of straight running at ``u`` [m/s] in calm water: the linear,
+        quadratic and wave-making terms of the surge damping."""
+        fn2 = u * u / (GRAVITY * LPP)
+        return (
+            self.linear_damping[0, 0] * u
+            + (self.surge_quadratic_damping + self.wave_resistance * fn2 * 0.5 * WATER_DENSITY
+               * WETTED_SURFACE) * abs(u) * u
+        )  # fmt: skip
 
     @classmethod
     def named(cls, name: str) -> RVGParams:
@@ -339,7 +375,8 @@ P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = (
 P_LIFT, P_INV_NREF = 46, 47
 P_STALL, P_SLIP, P_HULL_T, P_ADV = 48, 49, 50, 51  # stall angle, k_s 8/(rho pi D^2), 1-t, 1-w
 P_XVV, P_XVR, P_XRR, P_CF = 52, 53, 54, 55  # surge terms; rho/2 T C_cf
-P_CF_X = 56  # 12 Gauss-Legendre stations x [m] along the hull
+P_XW = 56  # rho S c_w / (2 g L) of the wave-making resistance
+P_CF_X = 57  # 12 Gauss-Legendre stations x [m] along the hull
 P_CF_W = P_CF_X + _GL_X.size  # and their weights [m]
 P_SIZE = P_CF_W + _GL_X.size
 
@@ -376,6 +413,7 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_HULL_T] = 1.0 - params.thrust_deduction
     p[P_ADV] = 1.0 - params.wake_fraction
     p[P_XVV], p[P_XVR], p[P_XRR] = params.surge_vv, params.surge_vr, params.surge_rr
+    p[P_XW] = WATER_DENSITY * WETTED_SURFACE * params.wave_resistance / (2.0 * GRAVITY * LPP)
     half = 0.5 * LPP
     p[P_CF] = 0.5 * WATER_DENSITY * DRAUGHT * params.crossflow_coefficient
     p[P_CF_X : P_CF_X + _GL_X.size] = (LPP - CG_FORWARD_OF_AP - half) + half * _GL_X
@@ -511,6 +549,8 @@ def rvg_row(x, u, p, c, out):
     d2 = p[P_DL + 6] * ur + p[P_DL + 7] * vr + p[P_DL + 8] * r + p[P_DQ + 2] * abs(r) * r
     # turning speed loss X_vv v^2 + X_vr v r + X_rr r^2 (zero in seed 001)
     d0 -= p[P_XVV] * vr * vr + p[P_XVR] * vr * r + p[P_XRR] * r * r
+    # wave-making resistance c_w Fn^2 rho/2 S |u_r| u_r (zero in seed 001)
+    d0 += p[P_XW] * ur * ur * abs(ur) * ur
     # sway-yaw cross terms of the cross-flow drag integral (zero in seed 001)
     if p[P_CF] != 0.0:
         cf_y = 0.0

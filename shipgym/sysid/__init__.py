@@ -1,4 +1,4 @@
-"""System identification from measured manoeuvring data (issue 4).
+"""System identification from measured manoeuvring data.
 
 * ``shipgym.sysid.data``: the canonical :class:`Record` and the loaders of the measured sources.
 * ``shipgym.sysid.fit``: equation-error and output-error fits of the Nomoto-family models with

@@ -1,6 +1,6 @@
 """Measured manoeuvring data: one canonical record type and loaders for every measured source.
 
-The system-identification tools (issue 4) fit Nomoto-type models (seed 000: the first-order
+The system-identification tools fit Nomoto-type models (seed 000: the first-order
 model ``T r' + r = K delta`` and its second-order relative) and 3-DOF models to measured time
 series. This module turns the six measured sources described in
 ``../shared/data/measured/SOURCES.md`` into one :class:`Record` in the project's units and sign

@@ -225,12 +225,12 @@ def identify(
                 continue
             dj, drop = family.compare(current, cand, name)
             ok = family.significant(cand, name, dj, drop)
-            scored[name] = {
+            scored[name] = {  # the family's scalar extras, never over the engine's own keys
+                **{k: v for k, v in cand.extra.items() if isinstance(v, int | float | str)},
                 "delta_J": dj,
                 "relative_drop": drop,
                 "significant": ok,
                 "heldout_rms": dict(cand.heldout_rms),
-                **{k: v for k, v in cand.extra.items() if isinstance(v, int | float | str)},
             }
             if ok:
                 good[name] = (cand, dj)
@@ -243,13 +243,18 @@ def identify(
         cand = good[best][0]
         before = dict(current.heldout_rms)
         current = family.accept(ctx, current, cand, best)
+        # a family's own evidence: its extras named ``evidence_<key>``, reported as ``<key>``
         evidence = {
-            "delta_J": scored[best]["delta_J"],
-            "relative_drop": scored[best]["relative_drop"],
-            "heldout_rms_before": before,
-            "heldout_rms_after": dict(current.heldout_rms),
+            k.removeprefix("evidence_"): v
+            for k, v in cand.extra.items()
+            if k.startswith("evidence_")
         }
-        evidence.update({k: v for k, v in cand.extra.items() if k.startswith("evidence_")})
+        evidence.update(
+            delta_J=scored[best]["delta_J"],
+            relative_drop=scored[best]["relative_drop"],
+            heldout_rms_before=before,
+            heldout_rms_after=dict(current.heldout_rms),
+        )
         effects.append(
             {
                 "name": best,

@@ -87,7 +87,7 @@ README_MARKER = "identification"
 """Name of the README block: ``<!-- identification -->`` ... ``<!-- /identification -->``."""
 
 BENCH_GOALS: dict[str, float] = {"fit": 1.0, "loop": 10.0, "gunnerus": 60.0}
-"""Goals [s] of issue 4: nomoto1 output-error fit of 10 000 samples, the whole loop on a
+"""Speed goals [s]: nomoto1 output-error fit of 10 000 samples, the whole loop on a
 10 000-sample record, the Gunnerus record with ``rvg3dof``."""
 
 _SOURCE_ORDER = ("sspa", "marin", "hsva", "esso_osaka", "usv", "gunnerus")
@@ -680,7 +680,7 @@ def render_document(
     out = [
         "# System identification of every measured record",
         "",
-        f"Produced by `{command}` (issue 4; `shipgym.sysid.report`). Do not edit by hand.",
+        f"Produced by `{command}` (`shipgym.sysid.report`). Do not edit by hand.",
         "",
     ]
     if config:
@@ -979,7 +979,7 @@ def benchmark_sysid(
     gunnerus: bool = True,
     progress: ProgressArg = True,
 ) -> dict[str, Any]:
-    """Time the identification against the goals of issue 4 (:data:`BENCH_GOALS`).
+    """Time the identification against its speed goals (:data:`BENCH_GOALS`).
 
     * ``fit``: :func:`shipgym.sysid.fit.fit_output_error` of ``nomoto1`` on a generated
       random-rudder record of 10 001 samples (``dt = 0.1`` s, 1000 s); median of ``repeats``;
@@ -1201,7 +1201,7 @@ def plot_benchmark(report: Mapping[str, Any], path: str | Path) -> Path:
     handles = [
         Line2D([], [], color="#2a8a4a", lw=8, label="meets goal"),
         Line2D([], [], color="#b8312f", lw=8, label="misses goal"),
-        Line2D([], [], color="black", ls="--", lw=1.5, label="goal (issue 4)"),
+        Line2D([], [], color="black", ls="--", lw=1.5, label="goal"),
     ]
     ax.legend(handles=handles, loc="lower right", fontsize=8)
     sysinfo = report.get("system", {})

@@ -30,7 +30,9 @@ change the held-out error by less than 0.3 deg.
                                             (percent order x 2.185), not the shaft speed. A
                                             lower thrust on the hull is the thrust deduction of
                                             ``propeller_hull_interaction``, not a factor
-``surge_quadratic_damping``  x0.5 .. x2     flat-plate guess 1/2 0.125 B T rho
+``surge_quadratic_damping``  x0.25 .. x2    flat-plate guess 1/2 0.125 B T rho; the floor is the
+                                            ITTC-57 friction line with a form factor of 1.2
+                                            (0.27x at Re 1-2e8)
 ``sway_linear_damping``      x0.5 .. x8     0.2 x VERES "engineering judgement"; the calibrated
                                             4-DOF set of MCSim_python has 1.68e5 (7.5x)
 ``yaw_linear_damping``       x0.5 .. x2     0.2 x VERES (as sway)
@@ -50,6 +52,9 @@ Effects (:data:`RVG_EFFECTS`, each a documented term of :mod:`shipgym.models.rvg
 * ``turn_speed_loss``: ``X_vv v^2 + X_vr v r + X_rr r^2`` with prime coefficients
   ``X'_vv`` in ``[-0.3, 0.1]``, ``X'_vr`` in ``[-0.5, 0.5]``, ``X'_rr`` in ``[-0.1, 0.1]``
   (``X = rho/2 L T (X'_vv v^2 + X'_vr L v r + X'_rr L^2 r^2)``; MMG hull ranges);
+* ``wave_resistance``: ``R_w = c_w Fn^2 rho/2 S u_r^2`` with ``c_w`` in ``[0, 0.1]`` (the
+  residuary resistance coefficient at Fn 0.3 of small ships is 1-10e-3, i.e. ``c_w``
+  0.01-0.1; Molland, Turnock and Hudson 2017);
 * ``crossflow_damping``: the sway-yaw cross terms of the cross-flow drag integral, ``C_cf`` in
   ``[0, 2]`` (2-D cross-flow drag of ship sections, Hoerner 1965);
 * ``azimuth_offset``: the pods' real azimuth is the order plus ``alpha_0`` (``|alpha_0| <= 5``
@@ -133,9 +138,12 @@ RVG_WINDOW_S = 60.0
 START_SMOOTHING_S = 4.0
 """Span [s] of the local fit that reads each window's starting state (:func:`start_states`)."""
 
-RVG_MIN_RELATIVE_DROP = 0.2
+RVG_MIN_RELATIVE_DROP = 0.15
 """Required drop of the held-out RMS (geometric mean over :data:`GUARD_CHANNELS`) to accept an
-RVG effect."""
+RVG effect. A real record's held-out speed error has a floor the model cannot reach (the
+Gunnerus trials run 0.2-0.37 m/s faster eastbound than westbound at the same rpm: an unmeasured
+current or wind), so a surge effect that removes a sixth of what is left is a real one (its
+BIC change is reported beside it)."""
 
 FIT_TOL = (1e-8, 2e-4)
 """Relative tolerances ``(ftol, xtol)`` of the fits (``least_squares``): the windowed simulation
@@ -187,8 +195,8 @@ CALIBRATED: dict[str, FreeParameter] = {
     for p in (
         _factor("bollard_thrust", _SEED.bollard_thrust, 0.9, 1.1,
                 "Kongsberg maker data; +-10 % for the rpm order against the shaft speed"),
-        _factor("surge_quadratic_damping", _SEED.surge_quadratic_damping, 0.5, 2.0,
-                "flat-plate guess 1/2 0.125 B T rho"),
+        _factor("surge_quadratic_damping", _SEED.surge_quadratic_damping, 0.25, 2.0,
+                "flat-plate guess 1/2 0.125 B T rho; ITTC-57 friction x (1 + k) is 0.27x"),
         _factor("sway_linear_damping", float(_SEED.linear_damping[1, 1]), 0.5, 8.0,
                 "0.2 x VERES viscous, judgement; MCSim's calibrated 4-DOF set has 7.5x"),
         _factor("yaw_linear_damping", float(_SEED.linear_damping[2, 2]), 0.5, 2.0,
@@ -212,6 +220,8 @@ _EFFECT_PARAMETERS: dict[str, FreeParameter] = {
         FreeParameter("X_vv_prime", -0.3, 0.1, scale=0.1, reason="MMG hulls: -0.15 .. 0"),
         FreeParameter("X_vr_prime", -0.5, 0.5, scale=0.1, reason="MMG hulls, with m_y"),
         FreeParameter("X_rr_prime", -0.1, 0.1, scale=0.01, reason="MMG hulls: -0.03 .. 0.03"),
+        FreeParameter("wave_resistance", 0.0, 0.1, scale=0.01,
+                      reason="residuary resistance C_R 1-10e-3 at Fn 0.3 (series data)"),
         FreeParameter("crossflow_coefficient", 0.0, 2.0, scale=0.5,
                       reason="2-D cross-flow drag of ship sections 0.5-1.5 (Hoerner)"),
         FreeParameter("alpha_0", -math.radians(5.0), math.radians(5.0), scale=math.radians(1.0),
@@ -247,6 +257,14 @@ RVG_EFFECTS: dict[str, Effect] = {
             ("X_vv_prime", "X_vr_prime", "X_rr_prime"),
             {"X_vv_prime": (-0.3, 0.1), "X_vr_prime": (-0.5, 0.5), "X_rr_prime": (-0.1, 0.1)},
             "Yasukawa and Yoshimura 2015 eq. 9",
+        ),
+        Effect(
+            "wave_resistance",
+            "X -= c_w Fn^2 rho/2 S |u_r| u_r, Fn = u_r / sqrt(g L)",
+            ("wave_resistance",),
+            {"wave_resistance": (0.0, 0.1)},
+            "Molland, Turnock and Hudson 2017 ch. 4 and 10 (wave-making resistance, wetted "
+            "surface)",
         ),
         Effect(
             "crossflow_damping",
@@ -289,6 +307,7 @@ GUARD_CHANNELS: dict[str, tuple[str, ...]] = {
     "thruster_lift": _MOTION,
     "propeller_hull_interaction": ("u",),
     "turn_speed_loss": ("u",),
+    "wave_resistance": ("u",),
     "crossflow_damping": ("psi", "r", "v"),
     "azimuth_offset": ("psi", "r"),
     "current": ("x", "y"),
