@@ -246,8 +246,20 @@ def _held(rec: Record, seconds: float) -> np.ndarray:
 
 def test_effect_catalogue_per_base() -> None:
     assert BASE_MODELS == ("nomoto1", "rvg3dof")
-    assert _RVG_EFFECTS == ("thruster_lift", "azimuth_offset", "current", "sway_offset")
-    assert EFFECTS == (*_NOMOTO_EFFECTS, "thruster_lift", "azimuth_offset", "sway_offset")
+    assert _RVG_EFFECTS == (
+        "thruster_lift",
+        "azimuth_offset",
+        "current",
+        "sway_offset",
+        "wave_resistance",
+    )
+    assert EFFECTS == (
+        *_NOMOTO_EFFECTS,
+        "thruster_lift",
+        "azimuth_offset",
+        "sway_offset",
+        "wave_resistance",
+    )
     assert set(EFFECT_DEFAULTS) == set(EFFECTS)
     assert EFFECT_DEFAULTS["thruster_lift"] == pytest.approx(5.22e3, rel=0.01)
     assert EFFECT_DEFAULTS["azimuth_offset"] == pytest.approx(math.radians(2.0))

@@ -45,6 +45,7 @@ def test_clean_rvg_record_gets_no_effect_and_calibration_near_seed001(seed: int)
         ("azimuth_offset", "alpha_0", math.radians(2.0), 0.15),
         ("current", "speed", 0.5, 0.15),
         ("sway_offset", "v_0", 0.2, 0.15),
+        ("wave_resistance", "wave_resistance", 0.1, 0.15),
     ],
 )
 def test_rvg_effect_is_named_recovered_and_halves_the_error(
@@ -54,9 +55,11 @@ def test_rvg_effect_is_named_recovered_and_halves_the_error(
     res = identify(rec, "rvg3dof")
     assert res.effect_names == [effect]
     assert res.effects[0]["parameters"][key] == pytest.approx(truth, rel=tol)
-    assert res.error_after["psi_rms_deg"] < 0.5 * res.error_before["psi_rms_deg"]
+    # the error of what the effect acts on halves: the speed for a resistance term
+    err = "u_rms_m_s" if effect == "wave_resistance" else "psi_rms_deg"
+    assert res.error_after[err] < 0.5 * res.error_before[err]
     held = res.heldout
-    assert held["error_after"]["psi_rms_deg"] < 0.5 * held["error_before"]["psi_rms_deg"]
+    assert held["error_after"][err] < 0.5 * held["error_before"][err]
     if effect == "current":
         v = rec.meta["truth"]["effect_params"]
         got = res.effects[0]["parameters"]
@@ -137,7 +140,8 @@ def _steady(params: RVGParams, rpm: float, azimuth_deg: float) -> tuple[float, f
 @pytest.mark.parametrize(
     ("rpm", "azimuth_deg", "r_deg_s", "diameter_m", "ratio"),
     [(170.0, 10.0, (2.26, 2.45), (223, 248), (0.85, 0.92)),
-     (165.0, 20.0, (3.47, 3.55), (122, 124), (0.71, 0.73))],
+     (165.0, 20.0, (3.47, 3.55), (122, 124), (0.71, 0.73)),
+     (106.0, 30.0, (2.66, 2.95), (68, 82), (0.49, 0.57))],
 )  # fmt: skip
 def test_sea_trials_set_turns_like_the_real_ship(
     rpm: float, azimuth_deg: float, r_deg_s: tuple, diameter_m: tuple, ratio: tuple
@@ -156,6 +160,22 @@ def test_sea_trials_set_turns_like_the_real_ship(
     assert within(q, ratio, tol=0.05)
     r, d, q = _steady(RVGParams(), rpm, azimuth_deg)
     assert not (within(-r, r_deg_s, rel=0.10) and within(d, diameter_m, rel=0.15))
+
+
+@pytest.mark.parametrize(("rpm", "speed"), [(110.0, 3.72), (170.0, 5.45), (195.0, 6.10)])
+def test_sea_trials_set_runs_straight_at_the_measured_speeds(rpm: float, speed: float) -> None:
+    """Straight running at the trials' rpm orders settles within 3 % of the measured mean
+    speeds (RVG_PARAMETERS.md; the runs on opposite headings differ by 4-10 % around these
+    means: current and wind). (Seed 001, held exactly straight, is 10 % slow at 110 rpm and
+    1 % slow at 195 rpm: its resistance grows as u^2 only.)"""
+    from shipgym.sysid.families.rvg import simulate_orders
+
+    t = np.arange(0.0, 900.0, 0.5)
+    s = simulate_orders(
+        RVGParams.sea_trials(), t, np.full(t.size, rpm), np.zeros(t.size), np.zeros(6)
+    )
+    assert abs(s[-1, 3] - s[-200, 3]) < 1e-3  # settled
+    assert s[-1, 3] == pytest.approx(speed, rel=0.03)
 
 
 def test_sea_trials_loop_names_the_pod_lift_first() -> None:

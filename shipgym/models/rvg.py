@@ -136,17 +136,21 @@ POD_LIFT_COEFFICIENT_THRUSTER_DATA = (
 
 #: Ship parameters identified from the Gunnerus sea trials of 27 Oct 2022 (``python
 #: scripts/identify_gunnerus.py``: the identification loop from the seed-001 base names the pod
-#: normal force and nothing after it; whole-record windowed output-error fit, see
-#: docs/gunnerus.md). Values not listed are the seed-001 ones. Three calibrated values end at
-#: their documented bounds: findings, reported in the README, not results.
+#: normal force, the wave-making resistance and the propeller-hull interaction, in that order;
+#: whole-record windowed output-error fit, see docs/gunnerus.md). Values not listed are the
+#: seed-001 ones. Three calibrated values end at their documented bounds: findings, reported in
+#: the README ("Known limitations"), not results.
 SEA_TRIALS_VALUES: dict[str, float] = {
     "bollard_thrust": 1.0953e5,  # x0.90 of the Kongsberg table: the calibrated range's floor
-    "surge_quadratic_damping": 1208.1,  # x0.72
-    "sway_linear_damping": 9.8203e4,  # x4.4 (MCSim's calibrated 4-DOF set: x7.5)
-    "yaw_linear_damping": 3.8794e6,  # x1.99: the range's ceiling
+    "surge_quadratic_damping": 417.9,  # x0.25: the ITTC-57 friction floor of the range
+    "sway_linear_damping": 8.7846e4,  # x3.9 (MCSim's calibrated 4-DOF set: x7.5)
+    "yaw_linear_damping": 2.6916e6,  # x1.38
     "sway_quadratic_damping": 9.4445e4,  # x4.0 (cross-flow C_D 2.0): the range's ceiling
-    "yaw_quadratic_damping": 7.8933e7,  # between 2.87e7 and 3.65e8
-    "pod_lift_coefficient": 3823.7,  # 0.73 x the Kongsberg pod FMU fit
+    "yaw_quadratic_damping": 8.001e7,  # between 2.87e7 and 3.65e8
+    "pod_lift_coefficient": 3992.6,  # 0.76 x the Kongsberg pod FMU fit
+    "wave_resistance": 0.03209,  # c_w: C_w = 3.6e-3 at Fn 0.33 (6.1 m/s)
+    "thrust_deduction": 0.2595,  # twin pods: 0.05-0.3
+    "wake_fraction": 0.04705,
 }
 
 

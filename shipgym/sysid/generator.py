@@ -76,6 +76,9 @@ effect              definition
                     a speed-log or GNSS-antenna misalignment, as the Gunnerus record's
                     +0.2 m/s on straight runs on every heading (SOURCES.md oddity 3). The
                     ship is the clean one; only the recorded ``v`` (and ``U``) differ.
+``wave_resistance`` The hull makes waves: the true ship has ``RVGParams(wave_resistance=c_w)``
+                    (0.1), the resistance ``c_w Fn^2 rho/2 S u^2`` that grows faster than the
+                    seed's ``u^2`` drag (:mod:`shipgym.models.rvg`): slower at high rpm.
 =================== ===========================================================================
 
 Manoeuvres (``maneuver``):
@@ -183,7 +186,7 @@ EFFECTS_BY_BASE: dict[str, tuple[str, ...]] = {
         "current",
         "second_order",
     ),
-    "rvg3dof": ("thruster_lift", "azimuth_offset", "current", "sway_offset"),
+    "rvg3dof": ("thruster_lift", "azimuth_offset", "current", "sway_offset", "wave_resistance"),
 }
 """The undeclared effects defined for each base model (see the module docstring)."""
 
@@ -203,6 +206,8 @@ EFFECT_DEFAULTS: dict[str, float] = {
     "thruster_lift": _rvg.POD_LIFT_COEFFICIENT_FMU,  # c_L [N s^2/m^2]
     "azimuth_offset": math.radians(2.0),  # alpha_0 [rad]
     "sway_offset": 0.2,  # v_0 [m/s]
+    "wave_resistance": 0.1,  # c_w [-] (the generated ship tops at Fn 0.29: a smaller c_w is
+    # within what the calibrated u^2 drag absorbs over its speed range)
 }
 """Default ``magnitude`` of each effect, in the unit of the module docstring's tables."""
 
@@ -292,7 +297,8 @@ def _check_inputs(
         if effect in ("rudder_lag", "second_order") and magnitude <= 0.0:
             raise ValueError(f"magnitude of {effect!r} is a time constant and must be > 0 s")
         if (
-            effect in ("input_delay", "current", "yaw_nonlinearity", "thruster_lift")
+            effect
+            in ("input_delay", "current", "yaw_nonlinearity", "thruster_lift", "wave_resistance")
             and magnitude < 0.0
         ):
             raise ValueError(f"magnitude of {effect!r} must be >= 0, got {magnitude!r}")
@@ -610,6 +616,10 @@ def _rvg_record(
     elif effect == "sway_offset":
         assert magnitude is not None
         effect_params = {"v_0": magnitude}
+    elif effect == "wave_resistance":
+        assert magnitude is not None
+        params = RVGParams(wave_resistance=magnitude)
+        effect_params = {"c_w": magnitude}
     model = make_model("rvg3dof", params)
     p = model.p
     t_end = (n_fine + 1) * h

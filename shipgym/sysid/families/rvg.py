@@ -72,8 +72,8 @@ RMS of a first pass (one reweighting), on the training samples. The engine
 (:mod:`shipgym.sysid.engine`) scores the held-out windows by the Gaussian BIC; the relative-drop
 guard asks the held-out RMS of the channels the effect acts on (:data:`GUARD_CHANNELS`:
 ``u`` for the surge effects, the motion for the pod lift ...) to drop by
-:data:`RVG_MIN_RELATIVE_DROP` (geometric mean), and no motion channel to get worse by more than
-:data:`MAX_WORSENING`. (A guard on all motion channels at once would never let a surge effect
+:data:`RVG_MIN_RELATIVE_DROP` (geometric mean), and none of heading, yaw rate, speed and
+position (one 2-D error) to get worse by more than :data:`MAX_WORSENING`. (A guard on all motion channels at once would never let a surge effect
 in: a 30 % better speed moves the geometric mean of five channels by 7 %.)
 """
 
@@ -151,7 +151,8 @@ error of a real record is not worth more digits, and it keeps the loop fast. (A 
 stops the trust region after its first short step, before the fit has moved.)"""
 
 MAX_WORSENING = 0.05
-"""Largest relative rise of any held-out motion channel's RMS an accepted effect may cause."""
+"""Largest relative rise of the held-out RMS of heading, yaw rate, speed or position (one 2-D
+error) an accepted effect may cause."""
 
 _HALF_RHO_LT = 0.5 * WATER_DENSITY * LPP * DRAUGHT  # prime -> dimensional X_vv [kg/m]
 
@@ -744,6 +745,15 @@ def _geometric_mean(rms: Mapping[str, float], channels: tuple[str, ...] | list[s
     return math.exp(float(np.mean([math.log(max(rms[k], 1e-300)) for k in channels])))
 
 
+def _worsening(before: Mapping[str, float], after: Mapping[str, float]) -> float:
+    """Largest relative rise of the held-out RMS of heading, yaw rate, speed and position; the
+    position error is one 2-D error (``hypot`` of north and east), so the guard does not depend
+    on the record's headings."""
+    rises = [after[c] / before[c] - 1.0 for c in ("psi", "r", "u")]
+    rises.append(math.hypot(after["x"], after["y"]) / math.hypot(before["x"], before["y"]) - 1.0)
+    return max(rises)
+
+
 class RVGFamily(ModelFamily):
     """The R/V Gunnerus 3-DOF model as an identification family (module docstring)."""
 
@@ -800,8 +810,8 @@ class RVGFamily(ModelFamily):
         drop = 1.0 - _geometric_mean(cand.heldout_rms, chans) / _geometric_mean(
             current.heldout_rms, chans
         )
-        worse = max(cand.heldout_rms[c] / current.heldout_rms[c] - 1.0 for c in _MOTION)
-        return dj, (drop if worse <= MAX_WORSENING else -math.inf)
+        return dj, (drop if _worsening(current.heldout_rms, cand.heldout_rms) <= MAX_WORSENING
+                    else -math.inf)  # fmt: skip
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         fit = fit_rvg(ctx.record, ctx.starts, ctx.train)
