@@ -20,7 +20,14 @@ from gymnasium.vector import AutoresetMode
 from shipgym.benchmark import evaluate, make_policy
 from shipgym.envs import ENV_IDS
 from shipgym.rl.agents import AGENT_DIR, agent_files, load_agent, load_meta
-from shipgym.rl.train import ALGOS, BENCHMARK_SEED, VALIDATION_SEED, agent_name, train
+from shipgym.rl.train import (
+    ALGOS,
+    BENCHMARK_SEED,
+    VALIDATION_SEED,
+    agent_name,
+    console_logger,
+    train,
+)
 from shipgym.rl.vec_env import ShipgymVecEnv
 
 
@@ -143,6 +150,7 @@ def test_training_changes_the_policy(tmp_path: Path) -> None:
     from stable_baselines3 import PPO
 
     model = PPO("MlpPolicy", ShipgymVecEnv("shipgym/RVGSpeed-v0", 2), seed=0, **TINY["ppo"])
+    model.set_logger(console_logger(0))
     before = [p.detach().clone() for p in model.policy.parameters()]
     model.learn(64)
     after = list(model.policy.parameters())

@@ -42,7 +42,7 @@ def ppo_steps_per_second(env_id: str, timesteps: int, seed: int = 0) -> float:
     """Environment steps per second of PPO ``learn`` on ``env_id`` (after one warm-up rollout)."""
     from stable_baselines3 import PPO
 
-    from shipgym.rl.train import DEFAULTS
+    from shipgym.rl.train import DEFAULTS, console_logger
 
     settings = DEFAULTS["ppo"]
     params = dict(settings["hyperparameters"])
@@ -52,6 +52,7 @@ def ppo_steps_per_second(env_id: str, timesteps: int, seed: int = 0) -> float:
         }
     venv = _make_venv(env_id, settings["num_envs"], seed)
     model = PPO("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **params)
+    model.set_logger(console_logger(0))
     rollout = params["n_steps"] * settings["num_envs"]
     model.learn(rollout)  # warm-up: kernels, torch, first update
     start = time.perf_counter()

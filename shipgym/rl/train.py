@@ -116,6 +116,19 @@ class TrainResult:
     meta: dict[str, Any] = field(repr=False)
 
 
+def console_logger(verbose: int = 0) -> Any:
+    """An SB3 logger that writes to stdout (``verbose >= 1``) or nowhere, and no folder.
+
+    SB3's default logger makes an ``SB3-<date>`` folder in the temporary directory on every
+    ``learn`` even when it writes nothing there; pass this to ``model.set_logger`` instead.
+    """
+    import sys
+
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger
+
+    return Logger(folder=None, output_formats=[HumanOutputFormat(sys.stdout)] if verbose else [])
+
+
 def _obs_normaliser(vec_normalize: Any) -> dict[str, Any]:
     rms = vec_normalize.obs_rms
     return {
@@ -234,6 +247,7 @@ def train(
     )
     cls = {"ppo": PPO, "sac": SAC}[algo]
     model = cls("MlpPolicy", venv, seed=seed, verbose=verbose, device="cpu", **params)
+    model.set_logger(console_logger(verbose))
 
     best: dict[str, Any] = {}
     with tempfile.TemporaryDirectory() as tmp:

@@ -1,0 +1,48 @@
+"""Test-session setup: the run's temporary files live in one folder, removed at the end.
+
+``TMPDIR`` (for subprocesses), :data:`tempfile.tempdir` and pytest's ``tmp_path`` base all point
+into a fresh folder for the session. Whatever the code under test leaves there outside pytest's
+own ``tmp_path`` folders (an ``SB3-<date>`` logger folder, a temporary file not cleaned up) fails
+the run with the names of what was left; the folder is removed either way, so a test run leaves
+nothing in the system's temporary directory.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+
+_ROOT = Path(tempfile.mkdtemp(prefix="shipgym-tests-"))
+_PYTEST_DIR = "pytest"
+#: torch makes its compiler cache folder ``torchinductor_<user>`` in the temporary directory
+#: when an optimiser is built; that is torch's cache, not a file a run forgot
+_THIRD_PARTY_CACHES = ("torchinductor_",)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.option.basetemp = str(_ROOT / _PYTEST_DIR)
+    os.environ["TMPDIR"] = str(_ROOT)
+    tempfile.tempdir = str(_ROOT)
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    left = sorted(
+        p.name
+        for p in _ROOT.iterdir()
+        if p.name != _PYTEST_DIR and not p.name.startswith(_THIRD_PARTY_CACHES)
+    )
+    if left:
+        reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+        if reporter is not None:
+            reporter.write_line(
+                f"the tests left these in the temporary directory: {', '.join(left)}", red=True
+            )
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    shutil.rmtree(_ROOT, ignore_errors=True)
