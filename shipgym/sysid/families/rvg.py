@@ -73,8 +73,9 @@ RMS of a first pass (one reweighting), on the training samples. The engine
 guard asks the held-out RMS of the channels the effect acts on (:data:`GUARD_CHANNELS`:
 ``u`` for the surge effects, the motion for the pod lift ...) to drop by
 :data:`RVG_MIN_RELATIVE_DROP` (geometric mean), and none of heading, yaw rate, speed and
-position (one 2-D error) to get worse by more than :data:`MAX_WORSENING`. (A guard on all motion channels at once would never let a surge effect
-in: a 30 % better speed moves the geometric mean of five channels by 7 %.)
+position (one 2-D error) to get worse by more than :data:`MAX_WORSENING`. (A guard on all
+motion channels at once would never let a surge effect in: a 30 % better speed moves the
+geometric mean of five channels by 7 %.)
 """
 
 from __future__ import annotations
