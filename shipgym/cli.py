@@ -639,7 +639,7 @@ def _build_train(sub: Any) -> None:
         type=_positive_int,
         default=None,
         metavar="N",
-        help="env steps between evaluations (default: 1/20 of the budget)",
+        help="env steps between evaluations (default: 1/20 of the budget; PPO: at least a rollout)",
     )
     p.add_argument(
         "--eval-episodes",

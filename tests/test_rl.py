@@ -145,6 +145,25 @@ def test_tiny_training_learns_saves_and_records(env_id: str, algo: str, tmp_path
     assert np.all(np.abs(actions) <= 1.0)
 
 
+def test_ppo_is_evaluated_once_a_rollout_by_default(tmp_path: Path) -> None:
+    """PPO's policy changes once a rollout (``n_steps x num_envs`` = 64 steps here); the default
+    evaluation frequency (1/20 of the budget) never evaluates it more often than that."""
+    result = train(
+        "shipgym/RVGSpeed-v0",
+        "ppo",
+        timesteps=128,
+        seed=3,
+        out_dir=tmp_path,
+        num_envs=2,
+        eval_episodes=1,
+        progress_bar=False,
+        hyperparameters=TINY["ppo"],
+    )
+    curve = json.loads(result.meta_path.read_text())["learning_curve"]["timesteps"]
+    assert 2 <= len(curve) <= 3  # after each of the two rollouts, and the final evaluation
+    assert all(b - a >= 64 for a, b in zip(curve[:-2], curve[1:-1], strict=True))
+
+
 def test_training_changes_the_policy(tmp_path: Path) -> None:
     """The tiny budget really updates the network (the smoke tests could not fail otherwise)."""
     from stable_baselines3 import PPO

@@ -180,7 +180,8 @@ def train(
     num_envs : int, optional
         Training sub-envs; default from :func:`config`.
     eval_freq : int, optional
-        Environment steps between evaluations (default: about 20 over the run).
+        Environment steps between evaluations (default: about 20 over the run, and for PPO at
+        least one rollout, ``n_steps x num_envs``: its policy only changes once a rollout).
     eval_episodes : int
         Validation episodes per evaluation (seeds ``VALIDATION_SEED + i``).
     progress_bar : bool
@@ -224,6 +225,8 @@ def train(
     params = {**cfg["hyperparameters"], **(hyperparameters or {})}
     if eval_freq is None:
         eval_freq = max(timesteps // 20, 1)
+        if algo == "ppo":  # the policy changes once a rollout; more evaluations repeat it
+            eval_freq = max(eval_freq, int(params.get("n_steps", 2048)) * num_envs)
     if not isinstance(eval_freq, int) or eval_freq < 1:
         raise ValueError(f"eval_freq must be an integer >= 1, got {eval_freq!r}")
     out = Path(out_dir)
