@@ -8,6 +8,7 @@ lockstep evaluation of memoryless policies matching the one-episode-at-a-time lo
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -161,7 +162,7 @@ def test_ppo_is_evaluated_once_a_rollout_by_default(tmp_path: Path) -> None:
     )
     curve = json.loads(result.meta_path.read_text())["learning_curve"]["timesteps"]
     assert 2 <= len(curve) <= 3  # after each of the two rollouts, and the final evaluation
-    assert all(b - a >= 64 for a, b in zip(curve[:-2], curve[1:-1], strict=True))
+    assert all(b - a >= 64 for a, b in itertools.pairwise(curve[:-1]))
 
 
 def test_training_changes_the_policy(tmp_path: Path) -> None:
