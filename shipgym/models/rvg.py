@@ -106,6 +106,16 @@ POD_SLIPSTREAM_FMU = 0.153
 strut sees (the thruster_lift effect keeps it fixed and fits ``c_L``)."""
 
 GRAVITY = 9.81  # [m/s^2]
+BLOCK_COEFFICIENT = 574_127.69 / WATER_DENSITY / (LPP * BREADTH * DRAUGHT)
+"""``C_B`` [-] of the seed-001 displacement on Lpp x B x T (0.64)."""
+THRUST_DEDUCTION_HOLTROP = 0.325 * BLOCK_COEFFICIENT - 0.1885 * PROPELLER_DIAMETER / math.sqrt(
+    BREADTH * DRAUGHT
+)
+"""Thrust deduction ``t`` [-] of twin-screw ships by Holtrop and Mennen (1982, eq. for twin
+screws: ``t = 0.325 C_B - 0.1885 D / sqrt(B T)``), 0.137 for the Gunnerus. A record without a
+thrust or shaft-speed measurement (the Gunnerus trials log the rpm *order*) fixes only the
+thrust on the hull, ``T (1 - t)``: ``t`` is then taken from this formula and the thrust level
+is identified (``propeller_hull_interaction`` fits the wake fraction)."""
 WETTED_SURFACE = 1.7 * LPP * DRAUGHT + 574_127.69 / WATER_DENSITY / DRAUGHT
 """Wetted hull surface ``S`` [m^2] by Denny and Mumford's formula ``1.7 L T + V / T`` (363 m^2;
 Molland, Turnock and Hudson 2017, ch. 10), the area of the wave-making resistance term."""
@@ -136,21 +146,21 @@ POD_LIFT_COEFFICIENT_THRUSTER_DATA = (
 
 #: Ship parameters identified from the Gunnerus sea trials of 27 Oct 2022 (``python
 #: scripts/identify_gunnerus.py``: the identification loop from the seed-001 base names the pod
-#: normal force, the wave-making resistance and the propeller-hull interaction, in that order;
-#: whole-record windowed output-error fit, see docs/gunnerus.md). Values not listed are the
-#: seed-001 ones. Three calibrated values end at their documented bounds: findings, reported in
-#: the README ("Known limitations"), not results.
+#: normal force and the wave-making resistance, in that order; whole-record windowed
+#: output-error fit, see docs/gunnerus.md). Values not listed are the seed-001 ones. Two
+#: calibrated values end at their documented bounds: findings, reported in the README ("Known
+#: limitations"), not results.
 SEA_TRIALS_VALUES: dict[str, float] = {
-    "bollard_thrust": 1.0953e5,  # x0.90 of the Kongsberg table: the calibrated range's floor
+    # x0.70 of the Kongsberg table: the thrust on the hull at the rpm order (no thrust deduction
+    # in this set); MCSim's manoeuvring model uses C_t 2.2, x0.72
+    "bollard_thrust": 8.5063e4,
     "surge_quadratic_damping": 417.9,  # x0.25: the ITTC-57 friction floor of the range
-    "sway_linear_damping": 8.7846e4,  # x3.9 (MCSim's calibrated 4-DOF set: x7.5)
-    "yaw_linear_damping": 2.6916e6,  # x1.38
+    "sway_linear_damping": 8.9333e4,  # x4.0 (MCSim's calibrated 4-DOF set: x7.5)
+    "yaw_linear_damping": 2.6522e6,  # x1.36
     "sway_quadratic_damping": 9.4445e4,  # x4.0 (cross-flow C_D 2.0): the range's ceiling
-    "yaw_quadratic_damping": 8.001e7,  # between 2.87e7 and 3.65e8
-    "pod_lift_coefficient": 3992.6,  # 0.76 x the Kongsberg pod FMU fit
-    "wave_resistance": 0.03209,  # c_w: C_w = 3.6e-3 at Fn 0.33 (6.1 m/s)
-    "thrust_deduction": 0.2595,  # twin pods: 0.05-0.3
-    "wake_fraction": 0.04705,
+    "yaw_quadratic_damping": 8.0523e7,  # between 2.87e7 and 3.65e8
+    "pod_lift_coefficient": 4105.6,  # 0.79 x the Kongsberg pod FMU fit
+    "wave_resistance": 0.027283,  # c_w: C_w = 3.0e-3 at Fn 0.33 (6.1 m/s)
 }
 
 
@@ -303,8 +313,8 @@ class RVGParams:
         """The parameter set identified from the Gunnerus sea trials (``SEA_TRIALS_VALUES``).
 
         Seed 001's model with the effects the identification loop named (pod normal force with
-        slipstream fraction ``POD_SLIPSTREAM_FMU``, wave-making resistance, thrust deduction and
-        wake fraction) and the calibrated guesses of the seed within their documented ranges
+        slipstream fraction ``POD_SLIPSTREAM_FMU``, wave-making resistance) and the calibrated
+        guesses of the seed within their documented ranges, the bollard thrust among them
         (README, "The real Gunnerus", and docs/gunnerus.md for the manoeuvres). Its
         ``service_thrust`` is the pod thrust that holds the service speed in this set
         (:meth:`straight_resistance`).
