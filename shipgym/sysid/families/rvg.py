@@ -73,7 +73,10 @@ Fit and criterion
 -----------------
 Weighted least squares (``scipy.optimize.least_squares``) of the windowed simulation error of
 the channels ``psi`` (wrapped), ``r``, ``u``, ``v``, ``x``, ``y``, each divided by its residual
-RMS of a first pass (one reweighting), on the training samples. The engine
+RMS of a first pass (one reweighting), on the training samples. Candidate effects are screened
+by a fit on the record thinned to :data:`SCREEN_STEP_S` steps, scored on every held-out sample;
+one that passes the engine's test there is refitted on every sample and judged by that fit. The
+engine
 (:mod:`shipgym.sysid.engine`) scores the held-out windows by the Gaussian BIC; the relative-drop
 guard asks the held-out RMS of the channels the effect acts on (:data:`GUARD_CHANNELS`:
 ``u`` for the surge effects, the motion for the pod lift ...) to drop by
@@ -131,6 +134,7 @@ __all__ = [
     "RVG_EFFECTS",
     "RVG_MIN_RELATIVE_DROP",
     "RVG_WINDOW_S",
+    "SCREEN_STEP_S",
     "FreeParameter",
     "RVGFamily",
     "RVGFit",
@@ -156,6 +160,13 @@ FIT_TOL = (1e-8, 2e-4)
 """Relative tolerances ``(ftol, xtol)`` of the fits (``least_squares``): the windowed simulation
 error of a real record is not worth more digits, and it keeps the loop fast. (A looser ``ftol``
 stops the trust region after its first short step, before the fit has moved.)"""
+
+SCREEN_STEP_S = 1.0
+"""Replay step [s] of the screening fits of candidate effects (``fit_rvg(..., stride)``): the
+record's samples thinned to about this step, which the model's fastest dynamics (the pods' 1 s
+time constants) allow RK4. On the Gunnerus trials (0.5 s samples) the loop names the same
+effects in a fifth less time; a candidate that passes on the thinned record is refitted on every
+sample and judged by that fit (on generated records, thinning alone lets spurious effects in)."""
 
 MAX_WORSENING = 0.05
 """Largest relative rise of the held-out RMS of heading, yaw rate, speed or position (one 2-D
@@ -606,6 +617,7 @@ def fit_rvg(
     calibrate: bool = True,
     max_nfev: int = 60,
     passes: int | None = None,
+    stride: int = 1,
 ) -> RVGFit:
     """Windowed output-error fit of the calibrated parameters plus the effects' parameters.
 
@@ -630,6 +642,10 @@ def fit_rvg(
     passes : int, optional
         Fits, each reweighting the channels by the residual RMS of the one before (default two
         from a cold start, one from ``init``, whose channel weights it keeps).
+    stride : int
+        Replay and fit every ``stride``-th sample only (the replay's steps ``stride`` times
+        longer, each window starting at the kept sample at or before its start): a screening
+        fit at ``1/stride`` of the cost (:data:`SCREEN_STEP_S`).
 
     Returns
     -------
@@ -639,6 +655,8 @@ def fit_rvg(
     unknown = [e for e in effects if e not in RVG_EFFECTS]
     if unknown:
         raise ValueError(f"unknown rvg3dof effects {unknown}; expected {tuple(RVG_EFFECTS)}")
+    if not (isinstance(stride, int) and not isinstance(stride, bool) and stride >= 1):
+        raise ValueError(f"stride must be an integer >= 1, got {stride!r}")
     base = base or RVGParams()
     free = [*(CALIBRATED.values() if calibrate else ())]
     free += [_EFFECT_PARAMETERS[k] for e in effects for k in RVG_EFFECTS[e].parameters]
@@ -657,11 +675,14 @@ def fit_rvg(
     hi = np.array([f.theta_bounds[1] for f in free])
     span = hi - lo
     theta0 = np.clip(theta0, lo + 1e-6 * span, hi - 1e-6 * span)
-    meas = measured_states(record)
-    start = start_states(record)
-    az = azimuth_orders(record)
-    out = np.empty((record.time.size, 10))
-    starts64 = np.asarray(starts, dtype=np.int64)
+    keep = slice(None, None, stride)
+    meas = measured_states(record)[keep]
+    start = start_states(record)[keep]
+    az = azimuth_orders(record)[keep]
+    time_, rpm = record.time[keep], record.rpm[keep]
+    mask = np.asarray(mask, dtype=bool)[keep]
+    out = np.empty((time_.size, 10))
+    starts64 = np.unique(np.asarray(starts, dtype=np.int64) // stride)
     has_v = record.v is not None
 
     def unpack(th: np.ndarray) -> dict[str, float]:
@@ -670,7 +691,7 @@ def fit_rvg(
     def simulate(th: np.ndarray) -> np.ndarray:
         vals = unpack(th)
         _windows_kernel(
-            record.time, start, record.rpm, az, starts64, pack_rvg(apply_values(base, vals)),
+            time_, start, rpm, az, starts64, pack_rvg(apply_values(base, vals)),
             np.array([vals.get("V_n", 0.0), vals.get("V_e", 0.0)]), vals.get("alpha_0", 0.0),
             vals.get("v_0", 0.0), out,
         )  # fmt: skip
@@ -750,6 +771,7 @@ class _Context:
     held: np.ndarray
     every: np.ndarray
     has_v: bool
+    stride: int
 
 
 def _geometric_mean(rms: Mapping[str, float], channels: tuple[str, ...] | list[str]) -> float:
@@ -791,9 +813,12 @@ class RVGFamily(ModelFamily):
         held = ~train
         first = np.zeros(t.size, dtype=bool)
         first[starts] = True  # the first sample of a window is the measurement itself
+        dt = float(np.median(np.diff(t)))
+        stride = max(1, int(SCREEN_STEP_S / dt + 1e-9))
         return _Context(
-            record, starts, split, train & ~first, held & ~first, ~first, record.v is not None
-        )
+            record, starts, split, train & ~first, held & ~first, ~first, record.v is not None,
+            stride,
+        )  # fmt: skip
 
     def _score(self, ctx: _Context, fit: RVGFit) -> Candidate:
         sim = fit.simulate(ctx.record, ctx.starts)
@@ -831,8 +856,17 @@ class RVGFamily(ModelFamily):
         return self._score(ctx, fit)
 
     def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
-        fit = fit_rvg(ctx.record, ctx.starts, ctx.train, (*current.effects, name), current.fitted)
-        return self._score(ctx, fit)
+        """A screening fit on the record thinned to :data:`SCREEN_STEP_S`, scored on every
+        held-out sample; a candidate that passes the engine's test there is refitted on every
+        sample (from the screening fit) and judged by that fit, so the thinning never decides
+        that an effect is in."""
+        effects = (*current.effects, name)
+        fit = fit_rvg(ctx.record, ctx.starts, ctx.train, effects, current.fitted, stride=ctx.stride)
+        cand = self._score(ctx, fit)
+        if ctx.stride > 1 and self.significant(cand, name, *self.compare(current, cand, name)):
+            fit = fit_rvg(ctx.record, ctx.starts, ctx.train, effects, fit)
+            cand = self._score(ctx, fit)
+        return cand
 
     def accept(self, ctx: _Context, current: Candidate, cand: Candidate, name: str) -> Candidate:
         """The accepted candidate polished: refitted with channel weights from its own residual
