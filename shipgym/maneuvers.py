@@ -1,8 +1,9 @@
 """Standard manoeuvring trials: zigzag, turning circle, pull-out, spiral and the IMO criteria.
 
 Every trial runs on every model of :mod:`shipgym.models` (``nomoto1``, ``nomoto2``, ``norrbin``,
-``bech``, ``rvg3dof``) through :meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>`
-with a controller callback; no physics is copied here. The ship starts on a straight course
+``bech``, ``rvg3dof``, ``kvlcc2``) through
+:meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>` with a controller callback; no
+physics is copied here. The ship starts on a straight course
 (heading north, ``psi0 = 0``) at its service speed in calm water, and the trial's "rudder" is:
 
 * **Nomoto family**: the rudder command ``delta_c`` through the steering gear (35 deg,
@@ -11,6 +12,9 @@ with a controller callback; no physics is copied here. The ship starts on a stra
   (25 kN), through the pod servos (1 s, 10 deg/s). A positive azimuth on the aft pods turns
   the ship to port (seed 001 eq. 19-20), so the trials use the *equivalent rudder*
   ``delta_equivalent = -azimuth``: a positive "rudder" is a starboard turn for every model.
+* **KVLCC2** (``kvlcc2``, the MMG standard model of the 7 m model): the rudder command through
+  its steering gear (35 deg, 15.7 deg/s: the full-scale 2.32 deg/s Froude-scaled), the
+  propeller at the model's self-propulsion point at the SIMMAN 2008 approach speed, 1.179 m/s.
 
 Trials (definitions of ITTC and IMO MSC/Circ.1053, Explanatory Notes to MSC.137(76)):
 
@@ -127,6 +131,7 @@ _MODEL_LABELS = {
     "norrbin": "Norrbin",
     "bech": "Bech",
     "rvg3dof": "3-DOF MCSim",
+    "kvlcc2": "MMG KVLCC2",
 }
 
 
@@ -162,13 +167,16 @@ class ShipParticulars:
 
 _MARINER = ShipParticulars("Mariner class cargo ship", 160.93, 23.17, 7.7)
 _GUNNERUS = ShipParticulars("R/V Gunnerus", 33.9, 9.6, 5.144)
-#: Model name -> ship particulars (Mariner: Fossen 1994 section 2.2; Gunnerus: seed 001).
+_KVLCC2 = ShipParticulars("KVLCC2 (7 m model)", 7.0, 1.27, 1.179)
+#: Model name -> ship particulars (Mariner: Fossen 1994 section 2.2; Gunnerus: seed 001;
+#: KVLCC2: the L7 model at the SIMMAN 2008 speed, Yasukawa and Yoshimura 2015).
 PARTICULARS: dict[str, ShipParticulars] = {
     "nomoto1": _MARINER,
     "nomoto2": _MARINER,
     "norrbin": _MARINER,
     "bech": _MARINER,
     "rvg3dof": _GUNNERUS,
+    "kvlcc2": _KVLCC2,
 }
 
 
@@ -216,6 +224,17 @@ _RIGS: dict[str, _RigSettings] = {
         spiral_rudders_deg=_down_leg(30.0, 25.0, 20.0, 15.0, 10.0, 5.0, 2.0),
         spiral_yaw_rate=0.08,
     ),
+    # the 7 m model: one ship length in 5.9 s, rudder at 15.7 deg/s
+    "kvlcc2": _RigSettings(
+        dt=0.05,
+        chunk=10.0,
+        max_hold=600.0,
+        max_duration=600.0,
+        kp=30.0,
+        ti=10.0,
+        spiral_rudders_deg=_down_leg(20.0, 15.0, 10.0, 5.0, 3.0, 2.0, 1.0),
+        spiral_yaw_rate=0.05,
+    ),
 }
 
 
@@ -250,6 +269,13 @@ class _Rig:
             self.x0[ship.index("u")] = self._rvg_straight_speed()
             self._iu, self._iv = ship.index("u"), ship.index("v")
             self._ia = (ship.index("alpha1"), ship.index("alpha2"))
+        elif ship.name == "kvlcc2":
+            p = ship.params
+            self.max_rudder = float(p.max_rudder)
+            self.shaft = p.self_propulsion_rps(self.particulars.speed)
+            self.x0[ship.index("u")] = self.particulars.speed
+            self._iu, self._iv = ship.index("u"), ship.index("v")
+            self._idelta = ship.index("delta")
         else:
             assert ship.surge is not None and ship.gear is not None
             self.shaft = float(ship.surge.service_shaft_speed)
@@ -290,8 +316,8 @@ class _Rig:
         return inputs[:, 0]
 
     def speed(self, states: np.ndarray) -> np.ndarray:
-        """Speed through the water [m/s] (``sqrt(u^2 + v^2)`` for the 3-DOF model)."""
-        if self.name == "rvg3dof":
+        """Speed through the water [m/s] (``sqrt(u^2 + v^2)`` for the 3-DOF models)."""
+        if self.name in ("rvg3dof", "kvlcc2"):
             return np.hypot(states[:, self._iu], states[:, self._iv])
         return states[:, self._iU]
 

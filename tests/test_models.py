@@ -925,5 +925,5 @@ def test_make_model_selects_the_rvg_parameter_set_by_name() -> None:
     np.testing.assert_array_equal(sea.linear_damping, RVGParams.sea_trials().linear_damping)
     with pytest.raises(ValueError, match="seed001"):
         make_model("rvg3dof", "gunnerus")
-    with pytest.raises(ValueError, match="rvg3dof only"):
+    with pytest.raises(ValueError, match="rvg3dof or kvlcc2 only"):
         make_model("nomoto1", "sea_trials")

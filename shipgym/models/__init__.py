@@ -12,6 +12,7 @@ from shipgym.models.base import (
     make_model,
 )
 from shipgym.models.current import Current, current_ned
+from shipgym.models.mmg import MMGParams
 from shipgym.models.nomoto import (
     BechParams,
     Nomoto1Params,
@@ -27,6 +28,7 @@ __all__ = [
     "NOMOTO_MODEL_NAMES",
     "BechParams",
     "Current",
+    "MMGParams",
     "Nomoto1Params",
     "Nomoto2Params",
     "NorrbinParams",

@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from shipgym.models import integrate
+from shipgym.models.mmg import MMG_INPUTS, MMG_STATES, MMGParams, pack_mmg
 from shipgym.models.nomoto import (
     FIRST_ORDER_STATES,
     NOMOTO_INPUTS,
@@ -30,7 +31,7 @@ from shipgym.models.nomoto import (
 )
 from shipgym.models.rvg import RVG_INPUTS, RVG_STATES, RVGParams, pack_rvg
 
-MODEL_NAMES = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof")
+MODEL_NAMES = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2")
 NOMOTO_MODEL_NAMES = MODEL_NAMES[:4]
 
 
@@ -80,7 +81,7 @@ class ShipModel:
     params : object
         The model's parameter dataclass (yaw parameters for the Nomoto family).
     gear, surge : SteeringGear, SurgeModel or None
-        Actuator and speed models of the Nomoto family (``None`` for the RVG).
+        Actuator and speed models of the Nomoto family (``None`` for the 3-DOF models).
     """
 
     name: str
@@ -98,6 +99,10 @@ class ShipModel:
             set_(self, "p", pack_rvg(self.params))
             set_(self, "state_names", RVG_STATES)
             set_(self, "input_names", RVG_INPUTS)
+        elif self.name == "kvlcc2":
+            set_(self, "p", pack_mmg(self.params))
+            set_(self, "state_names", MMG_STATES)
+            set_(self, "input_names", MMG_INPUTS)
         else:
             assert self.gear is not None and self.surge is not None
             set_(self, "p", pack_nomoto(self.params, self.gear, self.surge))
@@ -303,12 +308,12 @@ def make_model(
 
     Parameters
     ----------
-    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof"}
-        Model name.
+    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2"}
+        Model name (``kvlcc2``: the MMG standard model, :mod:`shipgym.models.mmg`).
     params : dataclass or str, optional
-        Parameters of the right type (e.g. :class:`Nomoto1Params`); defaults otherwise. For
-        ``rvg3dof`` also the name of a shipped set (``"seed001"``, ``"sea_trials"``:
-        :meth:`RVGParams.named`).
+        Parameters of the right type (e.g. :class:`Nomoto1Params`, :class:`MMGParams`);
+        defaults otherwise. For ``rvg3dof`` also the name of a shipped set (``"seed001"``,
+        ``"sea_trials"``: :meth:`RVGParams.named`), for ``kvlcc2`` ``"kvlcc2"``.
     gear, surge : SteeringGear, SurgeModel, optional
         Steering gear and surge model of the Nomoto family.
 
@@ -323,18 +328,19 @@ def make_model(
     """
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
-    expected = RVGParams if name == "rvg3dof" else _DEFAULT_YAW[name]
+    three_dof = {"rvg3dof": RVGParams, "kvlcc2": MMGParams}
+    expected = three_dof.get(name) or _DEFAULT_YAW[name]
     if isinstance(params, str):
-        if name != "rvg3dof":
+        if name not in three_dof:
             raise ValueError(
-                f"a parameter set name ({params!r}) selects a shipped set of rvg3dof only; "
-                f"model {name!r} takes {expected.__name__}"
+                f"a parameter set name ({params!r}) selects a shipped set of "
+                f"{' or '.join(three_dof)} only; model {name!r} takes {expected.__name__}"
             )
-        params = RVGParams.named(params)
+        params = expected.named(params)
     if params is None:
         params = expected()
     elif not isinstance(params, expected):
         raise ValueError(f"model {name!r} takes {expected.__name__}, got {type(params).__name__}")
-    if name == "rvg3dof":
+    if name in three_dof:
         return ShipModel(name, params)
     return ShipModel(name, params, gear or SteeringGear(), surge or SurgeModel())
