@@ -254,6 +254,19 @@ class _Rig:
         self.name = ship.name
         self.particulars = PARTICULARS[ship.name]
         self.settings = _RIGS[ship.name]
+        if ship.name == "kvlcc2":  # any length of the KVLCC2: the 7 m model's rig, Froude-scaled
+            p = ship.params
+            k = math.sqrt(p.length / _KVLCC2.length)
+            self.particulars = ShipParticulars(
+                f"KVLCC2 ({p.length:g} m)" if p.length != _KVLCC2.length else _KVLCC2.vessel,
+                p.length, p.breadth, p.approach_speed,
+            )  # fmt: skip
+            st = self.settings
+            self.settings = replace(
+                st, dt=st.dt * k, chunk=st.chunk * k, max_hold=st.max_hold * k,
+                max_duration=st.max_duration * k, ti=st.ti * k,
+                kp=st.kp * k, spiral_yaw_rate=st.spiral_yaw_rate / k,
+            )  # fmt: skip
         step = self.settings.dt if dt is None else dt
         if not (isinstance(step, int | float) and math.isfinite(step) and 0 < step <= 1.0):
             raise ValueError(f"dt must be a step in (0, 1] s, got {dt!r}")

@@ -24,8 +24,8 @@ from shipgym.models.mmg import KVLCC2_SCALE, KVLCC2_SIMMAN_SPEED
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _straight(ship, n: float, u0: float = KVLCC2_SIMMAN_SPEED) -> np.ndarray:
-    """Straight running at ``u0`` (the propeller speed ``n`` goes in the input)."""
+def _straight(ship, u0: float = KVLCC2_SIMMAN_SPEED) -> np.ndarray:
+    """State of straight running at ``u0`` [m/s] (heading north, rudder amidships)."""
     x0 = np.zeros(ship.nx)
     x0[ship.index("u")] = u0
     return x0
@@ -38,7 +38,7 @@ def test_self_propulsion_point_holds_the_simman_speed() -> None:
     n = p.self_propulsion_rps(KVLCC2_SIMMAN_SPEED)
     assert 11.0 < n < 13.0
     ship = make_model("kvlcc2")
-    x0 = _straight(ship, n)
+    x0 = _straight(ship)
     d = ship.deriv(x0, [0.0, n])[0]
     assert d[ship.index("u")] == pytest.approx(0.0, abs=1e-12)
     assert d[ship.index("v")] == 0.0 and d[ship.index("r")] == 0.0
@@ -54,7 +54,7 @@ def test_positive_rudder_turns_to_starboard_and_the_gear_is_rate_limited() -> No
     p = MMGParams.kvlcc2()
     n = p.self_propulsion_rps(KVLCC2_SIMMAN_SPEED)
     ship = make_model("kvlcc2")
-    res = ship.simulate(_straight(ship, n), np.tile([math.radians(20.0), n], (400, 1)), 0.05)
+    res = ship.simulate(_straight(ship), np.tile([math.radians(20.0), n], (400, 1)), 0.05)
     assert res["r"][-1] > 0.0 and res["psi"][-1] > 0.0
     rate = np.diff(res["delta"]) / 0.05
     assert np.max(rate) <= p.rudder_rate * (1 + 1e-9)
@@ -71,8 +71,8 @@ def test_a_uniform_current_only_carries_the_ship() -> None:
     ship = make_model("kvlcc2")
     cur = np.array([0.3, -0.2])
     cmd = np.tile([math.radians(35.0), n], (1500, 1))
-    calm = ship.simulate(_straight(ship, n), cmd, 0.05)
-    x0 = _straight(ship, n)
+    calm = ship.simulate(_straight(ship), cmd, 0.05)
+    x0 = _straight(ship)
     x0[ship.index("u")] += cur[0]  # heading north: the current's surge and sway components
     x0[ship.index("v")] += cur[1]
     moving = ship.simulate(x0, cmd, 0.05, current=cur)
@@ -83,25 +83,22 @@ def test_a_uniform_current_only_carries_the_ship() -> None:
 
 
 def test_full_scale_ship_turns_like_the_model_in_ship_lengths() -> None:
-    """Froude similarity: the 320 m ship at 1.179 sqrt(320 / 7) m/s makes the model's turning
-    circle in ship lengths, and its 35 deg advance and tactical diameter (3.1 L) lie within the
-    SIMMAN 2008 free-running results of about 3.1-3.3 L."""
+    """Froude similarity: the 320 m ship at 1.179 sqrt(320 / 7) m/s, on the trial rig scaled
+    with it, makes the model's turning circle in ship lengths, and the 35 deg advance and
+    tactical diameter (3.1 L) lie within the SIMMAN 2008 free-running results of about 3.1-3.3 L
+    (Yasukawa and Yoshimura 2015)."""
     model = maneuvers.turning_circle("kvlcc2", 35.0)
-    full = make_model("kvlcc2", MMGParams.kvlcc2().scaled(KVLCC2_SCALE))
-    assert full.params.approach_speed == pytest.approx(7.97, abs=0.01)
-    a, b = model.advance / 7.0, model.tactical_diameter / 7.0
-    assert 2.9 < a < 3.4 and 2.9 < b < 3.4
-    x0 = np.zeros(full.nx)
-    x0[full.index("u")] = full.params.approach_speed
-    n = full.params.self_propulsion_rps(full.params.approach_speed)
-    assert n == pytest.approx(
+    full_params = MMGParams.kvlcc2().scaled(KVLCC2_SCALE)
+    assert full_params.approach_speed == pytest.approx(7.97, abs=0.01)
+    assert full_params.self_propulsion_rps(full_params.approach_speed) == pytest.approx(
         MMGParams.kvlcc2().self_propulsion_rps(KVLCC2_SIMMAN_SPEED) / math.sqrt(KVLCC2_SCALE)
     )
-    dt = 0.05 * math.sqrt(KVLCC2_SCALE)
-    res = full.simulate(x0, np.tile([math.radians(35.0), n], (2000, 1)), dt)
-    psi = res["psi"]
-    i90 = int(np.argmax(psi >= math.pi / 2))
-    assert res["x"][i90] / 320.0 == pytest.approx(a, rel=0.02)
+    full = maneuvers.turning_circle(make_model("kvlcc2", full_params), 35.0)
+    assert full.particulars.length == pytest.approx(320.0)
+    a, b = model.advance / 7.0, model.tactical_diameter / 7.0
+    assert 2.9 < a < 3.4 and 2.9 < b < 3.4
+    assert full.advance / 320.0 == pytest.approx(a, rel=0.01)
+    assert full.tactical_diameter / 320.0 == pytest.approx(b, rel=0.01)
 
 
 def test_bad_parameters_are_refused() -> None:
