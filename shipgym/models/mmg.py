@@ -62,6 +62,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from shipgym.models._jit import row_kernel
+from shipgym.models.kinematics import body_current, planar_kinematics
 
 MMG_STATES = ("x", "y", "psi", "u", "v", "r", "delta")
 MMG_INPUTS = ("delta_c", "n")
@@ -359,12 +360,9 @@ def mmg_row(x, u, p, c, out):
     vg = x[IV]
     r = x[IR]
     delta = x[IDELTA]
-    out[IX] = cs * ug - sn * vg
-    out[IY] = sn * ug + cs * vg
-    out[IPSI] = r
+    planar_kinematics(ug, vg, r, cs, sn, out)
     # velocities relative to the water
-    uc = c[0] * cs + c[1] * sn
-    vc = -c[0] * sn + c[1] * cs
+    uc, vc = body_current(c, cs, sn)
     ur = ug - uc
     vr = vg - vc
     # U and beta at midship (the paper) or, with ShipMMG's formulas, at the centre of gravity

@@ -79,6 +79,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from shipgym.models._jit import row_kernel
+from shipgym.models.kinematics import body_current, planar_kinematics
 
 RVG_PARAMETER_SETS = ("seed001", "sea_trials")
 """Names of the shipped parameter sets (:meth:`RVGParams.named`)."""
@@ -451,10 +452,9 @@ def pod_thrust(rpm, ur, p):
 def pod_axial_inflow(x, c, p, k):
     """Inflow [m/s] along the axis of pod ``k`` (before the wake fraction) for state ``x`` and
     current ``c``: ``u_p cos alpha + v_p sin alpha`` (module docstring)."""
-    cs = math.cos(x[IPSI])
-    sn = math.sin(x[IPSI])
-    ur = x[IU] - (c[0] * cs + c[1] * sn)
-    vr = x[IV] - (-c[0] * sn + c[1] * cs)
+    uc, vc = body_current(c, math.cos(x[IPSI]), math.sin(x[IPSI]))
+    ur = x[IU] - uc
+    vr = x[IV] - vc
     a = x[IA1 + k]
     up = ur - p[P_POD + 2 * k + 1] * x[IR]
     vp = vr + p[P_POD + 2 * k] * x[IR]
@@ -493,13 +493,9 @@ def rvg_row(x, u, p, c, out):
     uu = x[IU]
     vv = x[IV]
     r = x[IR]
-    # eq. (6)
-    out[IX] = cs * uu - sn * vv
-    out[IY] = sn * uu + cs * vv
-    out[IPSI] = r
+    planar_kinematics(uu, vv, r, cs, sn, out)  # eq. (6)
     # eq. (8)-(10)
-    uc = c[0] * cs + c[1] * sn
-    vc = -c[0] * sn + c[1] * cs
+    uc, vc = body_current(c, cs, sn)
     ur = uu - uc
     vr = vv - vc
     # eq. (19)-(20), summed over both pods
