@@ -53,13 +53,11 @@ VARIANTS = {
 
 def _shipmmg_params(p: MMGParams) -> dict[str, float]:
     """ShipMMG's keyword arguments for the ship ``p`` (dimensional as ShipMMG wants them)."""
-    half_l2d = 0.5 * p.rho * p.length**2 * p.draught
-    m = p.mass
+    m_x, m_y, j_z = p.added_masses
     return dict(
-        L_pp=p.length, B=p.breadth, d=p.draught, x_G=p.x_g, D_p=p.propeller_diameter, m=m,
-        I_zG=m * (p.gyration * p.length) ** 2, A_R=p.rudder_area,
-        η=p.propeller_diameter / p.rudder_height, m_x=p.m_x * half_l2d, m_y=p.m_y * half_l2d,
-        J_z=p.j_z * half_l2d * p.length**2, f_α=p.f_alpha, ε=p.epsilon, t_R=p.t_r,
+        L_pp=p.length, B=p.breadth, d=p.draught, x_G=p.x_g, D_p=p.propeller_diameter, m=p.mass,
+        I_zG=p.yaw_inertia, A_R=p.rudder_area, η=p.propeller_diameter / p.rudder_height,
+        m_x=m_x, m_y=m_y, J_z=j_z, f_α=p.f_alpha, ε=p.epsilon, t_R=p.t_r,
         x_R=p.x_r * p.length, a_H=p.a_h, x_H=p.x_h * p.length, γ_R_minus=p.gamma_minus,
         γ_R_plus=p.gamma_plus, l_R=p.l_r, κ=p.kappa, t_P=p.t_p, w_P0=p.w_p0, x_P=p.x_p,
         k_0=p.k0, k_1=p.k1, k_2=p.k2, R_0_dash=p.r0, X_vv_dash=p.x_vv, X_vr_dash=p.x_vr,

@@ -61,7 +61,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from shipgym.models._jit import row_kernel
+from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.kinematics import body_current, planar_kinematics
 
 MMG_STATES = ("x", "y", "psi", "u", "v", "r", "delta")
@@ -243,6 +243,17 @@ class MMGParams:
         return self.rho * self.displacement
 
     @property
+    def added_masses(self) -> tuple[float, float, float]:
+        """``m_x``, ``m_y`` [kg] and ``J_z`` [kg m^2] from the prime values."""
+        half_l2d = 0.5 * self.rho * self.length**2 * self.draught
+        return self.m_x * half_l2d, self.m_y * half_l2d, self.j_z * half_l2d * self.length**2
+
+    @property
+    def yaw_inertia(self) -> float:
+        """``I_zG = m (gyration L)^2`` [kg m^2]."""
+        return self.mass * (self.gyration * self.length) ** 2
+
+    @property
     def approach_speed(self) -> float:
         """Trial speed [m/s]: the SIMMAN approach speed, Froude-scaled to this ship's length."""
         return KVLCC2_SIMMAN_SPEED * math.sqrt(self.length / 7.0)
@@ -267,36 +278,29 @@ class MMGParams:
             rudder_time_constant=self.rudder_time_constant * math.sqrt(factor),
         )
 
-    def straight_force(self, u: float, n: float) -> float:
-        """Surge force [N] on the ship running straight at ``u`` [m/s] with the propeller at
-        ``n`` [1/s]: ``(1 - t_P) T - R``, zero at the self-propulsion point."""
-        half = 0.5 * self.rho * self.length * self.draught * u * u
-        if n == 0.0:
-            return -half * self.r0
-        j = u * (1.0 - self.w_p0) / (n * self.propeller_diameter)
-        kt = self.k0 + self.k1 * j + self.k2 * j * j
-        return (
-            1.0 - self.t_p
-        ) * self.rho * n * n * self.propeller_diameter**4 * kt - half * self.r0
-
     def self_propulsion_rps(self, u: float) -> float:
         """Propeller revolutions [1/s] that hold straight running at ``u`` [m/s] (the model's
-        own self-propulsion point: thrust balances ``R'_0``)."""
+        own self-propulsion point: thrust balances ``R'_0``), from :func:`mmg_row`."""
         from scipy.optimize import brentq
 
         if not (math.isfinite(u) and u > 0.0):
             raise ValueError(f"speed must be a finite number > 0 m/s, got {u!r}")
+        p = pack_mmg(self)
+
+        def surge(n: float) -> float:
+            return float(_straight_surge_acceleration(u, n, p))
+
         hi = 1.0
-        while self.straight_force(u, hi) < 0.0:
+        while surge(hi) < 0.0:
             hi *= 2.0
             if hi > 1e4:
                 raise ValueError(f"no propeller speed holds {u!r} m/s with these parameters")
-        return float(brentq(lambda n: self.straight_force(u, n), 1e-6, hi, xtol=1e-12))
+        return float(brentq(surge, 1e-6, hi, xtol=1e-12))
 
 
 P_MU, P_MV, P_MVR, P_MR = 0, 1, 2, 3  # m + m_x, m + m_y, x_G m, I_zG + x_G^2 m + J_z
 P_INV = 4  # inverse of the 2x2 sway-yaw mass matrix (4 entries)
-P_XG_M = 8  # x_G m
+P_XG_BETA = 8  # x_G with ShipMMG's U and beta at G (``speed_at_cg``), else 0
 P_QX, P_QN = 9, 10  # rho/2 L d, rho/2 L^2 d
 P_L = 11
 P_HULL = 12  # r0, x_vv, x_vr, x_rr, x_vvvv, y_v..y_rrr (6), n_v..n_rrr (6): 17 entries
@@ -304,9 +308,8 @@ P_PROP = 29  # rho D^4 (1 - t_P), D, 1 - w_P0, k0, k1, k2, x'_P, C_1, C_2+, C_2-
 P_RUD = 39  # rho/2 A_R f_alpha, eta, eps, kappa, gamma-, gamma+, l'_R, 1 - t_R, 1 + a_H,
 #            x_R + a_H x_H [m]
 P_GEAR = 49  # max rudder, rate, 1 / T_delta
-P_WAKE_SHIPMMG, P_SPEED_AT_CG = 52, 53  # 1.0 for ShipMMG's formulas, else 0.0
-P_MASS = 54
-P_SIZE = 55
+P_WAKE_SHIPMMG = 52  # 1.0 for ShipMMG's wake formula, else 0.0
+P_SIZE = 53
 
 
 def pack_mmg(params: MMGParams) -> np.ndarray:
@@ -314,18 +317,14 @@ def pack_mmg(params: MMGParams) -> np.ndarray:
     q = params
     p = np.zeros(P_SIZE)
     m = q.mass
-    half_l2d = 0.5 * q.rho * q.length**2 * q.draught
-    mx = q.m_x * half_l2d
-    my = q.m_y * half_l2d
-    jz = q.j_z * half_l2d * q.length**2
-    izg = m * (q.gyration * q.length) ** 2
+    mx, my, jz = q.added_masses
     p[P_MU] = m + mx
     p[P_MV] = m + my
     p[P_MVR] = q.x_g * m
-    p[P_MR] = izg + q.x_g**2 * m + jz
+    p[P_MR] = q.yaw_inertia + q.x_g**2 * m + jz
     a = np.array([[p[P_MV], p[P_MVR]], [p[P_MVR], p[P_MR]]])
     p[P_INV : P_INV + 4] = np.linalg.inv(a).ravel()
-    p[P_XG_M] = q.x_g * m
+    p[P_XG_BETA] = q.x_g if q.speed_at_cg else 0.0
     p[P_QX] = 0.5 * q.rho * q.length * q.draught
     p[P_QN] = 0.5 * q.rho * q.length**2 * q.draught
     p[P_L] = q.length
@@ -345,8 +344,6 @@ def pack_mmg(params: MMGParams) -> np.ndarray:
     )  # fmt: skip
     p[P_GEAR : P_GEAR + 3] = (q.max_rudder, q.rudder_rate, 1.0 / q.rudder_time_constant)
     p[P_WAKE_SHIPMMG] = 1.0 if q.wake_formula == "shipmmg" else 0.0
-    p[P_SPEED_AT_CG] = 1.0 if q.speed_at_cg else 0.0
-    p[P_MASS] = m
     return p
 
 
@@ -366,7 +363,7 @@ def mmg_row(x, u, p, c, out):
     ur = ug - uc
     vr = vg - vc
     # U and beta at midship (the paper) or, with ShipMMG's formulas, at the centre of gravity
-    vb = vr - p[P_SPEED_AT_CG] * p[P_XG_M] / p[P_MASS] * r
+    vb = vr - p[P_XG_BETA] * r
     big_u = math.sqrt(ur * ur + vb * vb)
     length = p[P_L]
     if big_u > 1e-9:
@@ -425,7 +422,7 @@ def mmg_row(x, u, p, c, out):
     yr = -p[g + 8] * fn * cd
     nr = -p[g + 9] * fn * cd
     # motion (eq. 4), solved for the relative accelerations
-    xgm = p[P_XG_M]
+    xgm = p[P_MVR]
     bx = xh + xr + xp + p[P_MV] * vr * r + xgm * r * r
     by = yh + yr - p[P_MU] * ur * r
     bn = nh + nr - xgm * ur * r
@@ -437,3 +434,15 @@ def mmg_row(x, u, p, c, out):
     dc = min(max(u[0], -dmax), dmax)
     rate = p[P_GEAR + 1]
     out[IDELTA] = min(max((dc - delta) * p[P_GEAR + 2], -rate), rate)
+
+
+@kernel
+def _straight_surge_acceleration(u, n, p):  # pragma: no cover - jit
+    """``u'`` [m/s^2] of :func:`mmg_row` running straight at ``u`` with the propeller at ``n``
+    and the rudder amidships, in calm water."""
+    x = np.zeros(7)
+    x[IU] = u
+    inputs = np.array([0.0, n])
+    out = np.empty(7)
+    mmg_row(x, inputs, p, np.zeros(2), out)
+    return out[IU]

@@ -107,7 +107,8 @@ POD_SLIPSTREAM_FMU = 0.153
 strut sees (the thruster_lift effect keeps it fixed and fits ``c_L``)."""
 
 GRAVITY = 9.81  # [m/s^2]
-BLOCK_COEFFICIENT = 574_127.69 / WATER_DENSITY / (LPP * BREADTH * DRAUGHT)
+_DISPLACEMENT_VOLUME = 574_127.69 / WATER_DENSITY  # [m^3], of the seed-001 mass
+BLOCK_COEFFICIENT = _DISPLACEMENT_VOLUME / (LPP * BREADTH * DRAUGHT)
 """``C_B`` [-] of the seed-001 displacement on Lpp x B x T (0.64)."""
 THRUST_DEDUCTION_HOLTROP = 0.325 * BLOCK_COEFFICIENT - 0.1885 * PROPELLER_DIAMETER / math.sqrt(
     BREADTH * DRAUGHT
@@ -117,7 +118,7 @@ screws: ``t = 0.325 C_B - 0.1885 D / sqrt(B T)``), 0.137 for the Gunnerus. A rec
 thrust or shaft-speed measurement (the Gunnerus trials log the rpm *order*) fixes only the
 thrust on the hull, ``T (1 - t)``: ``t`` is then taken from this formula and the thrust level
 is identified (``propeller_hull_interaction`` fits the wake fraction)."""
-WETTED_SURFACE = 1.7 * LPP * DRAUGHT + 574_127.69 / WATER_DENSITY / DRAUGHT
+WETTED_SURFACE = 1.7 * LPP * DRAUGHT + _DISPLACEMENT_VOLUME / DRAUGHT
 """Wetted hull surface ``S`` [m^2] by Denny and Mumford's formula ``1.7 L T + V / T`` (363 m^2;
 Molland, Turnock and Hudson 2017, ch. 10), the area of the wave-making resistance term."""
 
