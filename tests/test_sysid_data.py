@@ -281,11 +281,187 @@ def test_gunnerus_facts() -> None:
 
 
 # ---------------------------------------------------------------------------------------------
+# 3-DOF channels: thrust (HSVA) and apparent wind (Esso Osaka)
+# ---------------------------------------------------------------------------------------------
+@needs_data
+def test_hsva_thrust() -> None:
+    for rel in (f for f in FILES if f.startswith("hsva")):
+        rec = _load(rel)
+        # SOURCES.md: column 11, thrust about 40-57 N (model scale)
+        assert rec.thrust is not None, rel
+        assert 35.0 < rec.thrust.min() and rec.thrust.max() < 60.0, rel
+        # self-propulsion point on the straight approach: about 41 N (SOURCES.md)
+        assert np.mean(rec.thrust[:10]) == pytest.approx(41.5, abs=2.5), rel
+        assert any("thrust" in c for c in rec.meta["conversions"])
+    # more rudder, more thrust (speed loss and drift in the larger zigzags)
+    assert _find("Z_35_05.dat").thrust.max() > _find("Z_05_01.dat").thrust.max() + 5.0
+
+
+def _esso_raw(rel: str) -> dict[str, np.ndarray]:
+    """The raw Esso columns (all-empty rows dropped, as the loader does)."""
+    path = MEASURED / rel
+    header = path.read_text().splitlines()[0].split(",")
+    data = np.genfromtxt(path, delimiter=",", skip_header=1)
+    data = data[~np.all(np.isnan(data), axis=1)]
+    return {name: data[:, j] for j, name in enumerate(header)}
+
+
+def _apparent_from_true(
+    rec: Record, v_true: np.ndarray, dir_true: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Apparent wind (speed, angle FROM, clockwise from the bow) from the true wind (FROM,
+    clockwise from x0) and the ship's velocity over ground."""
+    assert rec.u is not None and rec.v is not None
+    c, s = np.cos(rec.psi), np.sin(rec.psi)
+    # air velocity over ground (the wind blows towards dir_true + pi) minus the ship velocity
+    ax = -v_true * np.cos(dir_true) - (rec.u * c - rec.v * s)
+    ay = -v_true * np.sin(dir_true) - (rec.u * s + rec.v * c)
+    bx, by = ax * c + ay * s, -ax * s + ay * c  # body axes
+    return np.hypot(bx, by), np.arctan2(-by, -bx)  # the wind comes FROM -(bx, by)
+
+
+def _ang_err(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.mod(a - b + np.pi, 2.0 * np.pi) - np.pi
+
+
+@needs_data
+def test_esso_apparent_wind_matches_true_wind_and_ship_motion() -> None:
+    esso = [f for f in FILES if f.startswith("esso")]
+    assert len(esso) == 15
+    for rel in esso:
+        rec = _load(rel)
+        assert rec.wind_speed is not None and rec.wind_angle is not None, rel
+        assert np.all(np.isfinite(rec.wind_speed)) and np.all(np.isfinite(rec.wind_angle))
+        assert np.all(rec.wind_speed >= 0.0)
+        assert np.all((rec.wind_angle > -np.pi) & (rec.wind_angle <= np.pi)), rel
+        assert any("apparent" in n for n in rec.meta["notes"])
+        assert not any("not loaded)" in n and "wind channels" in n for n in rec.meta["notes"])
+        assert any("wind_angle" in c for c in rec.meta["conversions"])
+        raw = _esso_raw(rel)
+        assert raw["t [s]"].size == rec.n
+        speed, angle = _apparent_from_true(
+            rec, raw["wind_velo_true [m/s]"], raw["wind_dir_true [rad]"]
+        )
+        windy = rec.wind_speed > 0.5
+        assert windy.sum() > 0.5 * rec.n, rel
+        err = _ang_err(angle, rec.wind_angle)[windy]
+        rms_deg = math.degrees(float(np.sqrt(np.mean(err**2))))
+        # measured: 0.004-0.034 deg RMS; a wrong convention gives 20-100 deg
+        assert rms_deg < 0.5, f"{rel}: apparent wind angle RMS error {rms_deg:.3f} deg"
+        # measured: below 0.0006 m/s RMS
+        assert np.sqrt(np.mean((speed - rec.wind_speed) ** 2)) < 0.005, rel
+        # the check is sensitive: the ship motion (0.1-0.4 m/s) alone shifts the angle by
+        # several degrees RMS
+        still = _ang_err(raw["wind_dir_true [rad]"] - rec.psi, rec.wind_angle)[windy]
+        assert math.degrees(float(np.sqrt(np.mean(still**2)))) > 4.0, rel
+
+
+@needs_data
+def test_esso_wind_sign_convention() -> None:
+    # at rest (first sample, ship speed ~0) the apparent wind is the true wind seen from the bow:
+    # wind_angle = wind_dir_true - psi
+    rel = next(f for f in FILES if f.endswith("zigzag_31-Jul-2020_13_04_24.csv"))
+    rec, raw = _load(rel), _esso_raw(rel)
+    assert rec.U is not None and rec.U[0] < 0.01 and rec.wind_angle is not None
+    assert abs(_ang_err(raw["wind_dir_true [rad]"][0] - rec.psi[0], rec.wind_angle[0])) < 1e-3
+    # sailing in light air (true wind below half the ship speed) the apparent wind comes from
+    # ahead: |wind_angle| small (0 = head wind). Measured: 41 samples, at most 27 deg.
+    rel = next(f for f in FILES if f.endswith("turn_14-Sep-2020_14_16_04.csv"))
+    rec, raw = _load(rel), _esso_raw(rel)
+    assert rec.U is not None and rec.wind_angle is not None
+    calm = (raw["wind_velo_true [m/s]"] < 0.5 * rec.U) & (rec.U > 0.2)
+    assert calm.sum() > 20
+    assert np.all(np.abs(rec.wind_angle[calm]) < math.radians(45.0))
+
+
+def _wind_record(n: int = 101, dt: float = 0.1) -> Record:
+    rec = _synthetic(n=n, dt=dt)
+    t = rec.time
+    angle = np.mod(2.9 + 0.05 * t * 10.0 + np.pi, 2 * np.pi) - np.pi  # crosses +-pi
+    angle[angle == -np.pi] = np.pi
+    return Record(
+        **rec.channels(),
+        thrust=40.0 + np.sin(t),
+        wind_speed=1.0 + 0.1 * t,
+        wind_angle=angle,
+        meta=rec.meta,
+    )
+
+
+def test_canonical_round_trip_of_3dof_channels(tmp_path: Path) -> None:
+    rec = _wind_record()
+    rec.wind_angle[3] = np.pi  # the closed end of (-pi, pi]
+    rec.thrust[4] = 1.0 / 3.0
+    path = rec.to_csv(tmp_path / "w.csv")
+    header = next(line for line in path.read_text().splitlines() if not line.startswith("#"))
+    assert header == ("time_s,delta_rad,psi_rad,r_rad_s,rpm,thrust_N,wind_speed_m_s,wind_angle_rad")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        back = load(path)
+    assert back.channels().keys() == rec.channels().keys()
+    for key, values in rec.channels().items():
+        np.testing.assert_array_equal(getattr(back, key), values)
+    assert back.meta == rec.meta
+    # slicing keeps the channels
+    s = rec.slice(2.0, 5.0)
+    assert s.thrust is not None and s.wind_speed is not None and s.wind_angle is not None
+    np.testing.assert_array_equal(
+        s.wind_angle, rec.wind_angle[(rec.time >= 2.0) & (rec.time <= 5.0)]
+    )
+
+
+def test_resample_wraps_wind_angle() -> None:
+    t = np.arange(5) * 1.0
+    z = np.zeros(5)
+    angle = np.array([3.0, 3.1, -3.1, -3.0, -2.9])  # crosses pi between samples 1 and 2
+    rec = Record(time=t, delta=z, psi=z, r=z, wind_speed=np.ones(5), wind_angle=angle)
+    res = rec.resample(0.5)
+    assert res.wind_angle is not None and res.wind_speed is not None
+    # halfway between 3.1 and -3.1 is +-pi (through the stern), not 0 (the bow)
+    mid = res.wind_angle[3]
+    assert abs(abs(mid) - np.pi) < 1e-12 and mid == np.pi
+    assert np.all((res.wind_angle > -np.pi) & (res.wind_angle <= np.pi))
+    np.testing.assert_allclose(res.wind_angle[::2], angle)
+    np.testing.assert_allclose(res.wind_speed, 1.0)
+
+
+def test_wind_channel_validation(tmp_path: Path) -> None:
+    t = np.arange(5.0)
+    with pytest.raises(ValueError, match=r"wrapped to \(-pi, pi\]"):
+        Record(time=t, delta=t, psi=t, r=t, wind_angle=np.full(5, 4.0))
+    with pytest.raises(ValueError, match=r"wrapped to \(-pi, pi\]"):
+        Record(time=t, delta=t, psi=t, r=t, wind_angle=np.full(5, -np.pi))
+    with pytest.raises(ValueError, match="wind_speed must be >= 0"):
+        Record(time=t, delta=t, psi=t, r=t, wind_speed=np.full(5, -1.0))
+    # a canonical file with an angle in [0, 2 pi) is wrapped, with a warning
+    rows = "\n".join(
+        f"{a!r},0.0,0.0,0.0,{b!r}"
+        for a, b in zip(t.tolist(), [0.0, 1.0, 4.0, 6.0, 7.0], strict=True)
+    )
+    path = tmp_path / "w.csv"
+    path.write_text("time_s,delta_rad,psi_rad,r_rad_s,wind_angle_rad\n" + rows + "\n")
+    with pytest.warns(SysidDataWarning, match="wind_angle outside"):
+        rec = load(path)
+    assert rec.wind_angle is not None
+    np.testing.assert_allclose(
+        rec.wind_angle, [0.0, 1.0, 4.0 - 2 * np.pi, 6.0 - 2 * np.pi, 7.0 - 2 * np.pi]
+    )
+    assert rec.wind_angle[0] == 0.0 and rec.wind_angle[1] == 1.0  # inside: kept bit for bit
+
+
+# ---------------------------------------------------------------------------------------------
 # canonical CSV, slicing, resampling
 # ---------------------------------------------------------------------------------------------
 @needs_data
 @pytest.mark.parametrize(
-    "name", ["RVG_ManeuveringTests.csv", "MARIN_FREE_KVLCC2_zz_10_m.dat", "example_zigzag.csv"]
+    "name",
+    [
+        "RVG_ManeuveringTests.csv",
+        "MARIN_FREE_KVLCC2_zz_10_m.dat",
+        "example_zigzag.csv",
+        "HSVA_CPMC_KVLCC2_Z_10_10_S.dat",  # thrust
+        "turn_14-Sep-2020_14_16_04.csv",  # apparent wind, angle crossing +-pi
+    ],
 )
 def test_canonical_round_trip_of_measured(tmp_path: Path, name: str) -> None:
     rec = _find(name)
@@ -327,6 +503,9 @@ def test_canonical_header_units_and_round_trip(tmp_path: Path) -> None:
         np.testing.assert_array_equal(getattr(back, key), values)
     assert back.meta == rec.meta
     assert back.x is None and back.azimuth is None
+    # a record without the 3-DOF channels: none written, none read back
+    assert back.thrust is None and back.wind_speed is None and back.wind_angle is None
+    assert "thrust" not in back.channels() and "wind_angle" not in back.channels()
 
 
 def test_slice_and_resample() -> None:

@@ -22,6 +22,7 @@ from shipgym.models.nomoto import (
     SurgeModel,
 )
 from shipgym.models.rvg import RVGParams
+from shipgym.models.vmm import VMMParams
 
 __all__ = [
     "MODEL_NAMES",
@@ -37,6 +38,7 @@ __all__ = [
     "SimulationResult",
     "SteeringGear",
     "SurgeModel",
+    "VMMParams",
     "current_ned",
     "make_model",
     "ssa",

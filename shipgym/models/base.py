@@ -8,6 +8,7 @@ python-control response object).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,8 +31,9 @@ from shipgym.models.nomoto import (
     pack_nomoto,
 )
 from shipgym.models.rvg import RVG_INPUTS, RVG_STATES, RVGParams, pack_rvg
+from shipgym.models.vmm import VMM_INPUTS, VMM_STATES, VMMParams, pack_vmm
 
-MODEL_NAMES = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2")
+MODEL_NAMES = ("nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2", "vmm")
 NOMOTO_MODEL_NAMES = MODEL_NAMES[:4]
 
 
@@ -103,6 +105,10 @@ class ShipModel:
             set_(self, "p", pack_mmg(self.params))
             set_(self, "state_names", MMG_STATES)
             set_(self, "input_names", MMG_INPUTS)
+        elif self.name == "vmm":
+            set_(self, "p", pack_vmm(self.params))
+            set_(self, "state_names", VMM_STATES)
+            set_(self, "input_names", VMM_INPUTS)
         else:
             assert self.gear is not None and self.surge is not None
             set_(self, "p", pack_nomoto(self.params, self.gear, self.surge))
@@ -308,12 +314,14 @@ def make_model(
 
     Parameters
     ----------
-    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2"}
-        Model name (``kvlcc2``: the MMG standard model, :mod:`shipgym.models.mmg`).
+    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2", "vmm"}
+        Model name (``kvlcc2``: the MMG standard model, :mod:`shipgym.models.mmg`; ``vmm``:
+        seed 003's general model, :mod:`shipgym.models.vmm`).
     params : dataclass or str, optional
         Parameters of the right type (e.g. :class:`Nomoto1Params`, :class:`MMGParams`);
         defaults otherwise. For ``rvg3dof`` also the name of a shipped set (``"seed001"``,
-        ``"sea_trials"``: :meth:`RVGParams.named`), for ``kvlcc2`` ``"kvlcc2"``.
+        ``"sea_trials"``: :meth:`RVGParams.named`), for ``kvlcc2`` ``"kvlcc2"``; ``vmm`` needs
+        :class:`VMMParams` or the path of a fitted model's JSON (:meth:`VMMParams.load`).
     gear, surge : SteeringGear, SurgeModel, optional
         Steering gear and surge model of the Nomoto family.
 
@@ -328,6 +336,15 @@ def make_model(
     """
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
+    if name == "vmm":
+        if isinstance(params, str | os.PathLike):
+            params = VMMParams.load(params)
+        if not isinstance(params, VMMParams):
+            raise ValueError(
+                "model 'vmm' takes VMMParams or the path of a fitted model's JSON "
+                f"(shipgym identify --model vmm:... --json FILE), got {type(params).__name__}"
+            )
+        return ShipModel(name, params)
     three_dof = {"rvg3dof": RVGParams, "kvlcc2": MMGParams}
     expected = three_dof.get(name) or _DEFAULT_YAW[name]
     if isinstance(params, str):

@@ -10,7 +10,7 @@ environments, the manoeuvres and identification, integrates through these functi
 Both run ship by ship through ``rk4_stages``, whose four stages use small work vectors that
 stay in the CPU cache; the environments' kernels call ``rk4_row`` (the same stages over the
 environment models' derivative ``row_rhs``) inside their own row loops, so they do not compile
-the MMG model, which no environment uses (it would add 40 % to their compile time).
+the 3-DOF model-test models (MMG, VMM), which no environment uses (it would add 40 % to their compile time).
 """
 
 from __future__ import annotations
@@ -21,8 +21,9 @@ from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.mmg import mmg_row
 from shipgym.models.nomoto import bech_row, nomoto1_row, nomoto2_row, norrbin_row
 from shipgym.models.rvg import rvg_row
+from shipgym.models.vmm import vmm_row
 
-NOMOTO1, NOMOTO2, NORRBIN, BECH, RVG3DOF, KVLCC2 = 0, 1, 2, 3, 4, 5
+NOMOTO1, NOMOTO2, NORRBIN, BECH, RVG3DOF, KVLCC2, VMM = 0, 1, 2, 3, 4, 5, 6
 
 
 @row_kernel
@@ -43,9 +44,12 @@ def row_rhs(model_id, x, u, p, c, out):
 
 @row_kernel
 def row_rhs_all(model_id, x, u, p, c, out):
-    """State derivative of one ship of any model: :func:`row_rhs` and the MMG model."""
+    """State derivative of one ship of any model: :func:`row_rhs`, the MMG model and the
+    general VMM."""
     if model_id == KVLCC2:
         mmg_row(x, u, p, c, out)
+    elif model_id == VMM:
+        vmm_row(x, u, p, c, out)
     else:
         row_rhs(model_id, x, u, p, c, out)
 

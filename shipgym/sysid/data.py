@@ -14,8 +14,11 @@ convention:
 * yaw rate ``r`` [rad/s], positive clockwise;
 * optional (``None`` when absent): position ``x``, ``y`` [m] (north/east or the source's
   earth-fixed x/y frame), **body-fixed** ``u``, ``v`` [m/s], speed ``U`` [m/s], pod azimuth
-  ``azimuth`` [rad] (raw pod sign: positive turns to PORT, seed 001 eq. 19-20) and ``rpm``
-  [rev/min].
+  ``azimuth`` [rad] (raw pod sign: positive turns to PORT, seed 001 eq. 19-20), ``rpm``
+  [rev/min], total propeller ``thrust`` [N], and the apparent (relative) wind at the ship:
+  ``wind_speed`` [m/s] and ``wind_angle`` [rad], the direction the wind comes FROM measured from
+  the bow, positive clockwise (to starboard), wrapped to (-pi, pi]: 0 = head wind, +pi/2 = wind
+  from starboard (pushes the ship to port).
 
 Per-source conversions (the columns and conventions are those verified in SOURCES.md):
 
@@ -28,9 +31,13 @@ marin       full scale. deg -> rad for psi, r, delta; delta negated; time rebuil
             ``index * 0.135264 s`` (3-significant-digit time stamps); earth-fixed dx0/dt,
             dy0/dt rotated into body u, v.
 hsva        model scale, cp1252 header. deg -> rad; delta negated ("positive steering to port
-            side"); earth-fixed velocities rotated into body u, v; rpm = 60 n.
+            side"); earth-fixed velocities rotated into body u, v; rpm = 60 n; thrust [N] from
+            column 11.
 esso_osaka  MMG convention already starboard-positive (no flip); psi_hat unwrapped;
-            rpm = 60 n; trailing all-empty rows dropped.
+            rpm = 60 n; trailing all-empty rows dropped. Apparent wind from
+            ``wind_velo_relative_mid`` / ``wind_dir_relative_mid``: the source angle is already
+            "from", clockwise from the bow (verified against the true wind and the ship motion,
+            residual below 0.04 deg RMS), only wrapped from [0, 2 pi) to (-pi, pi].
 usv         delta from the measured ``rudder`` column [deg] (starboard-positive; the ``delta``
             and ``-rudder`` columns of the file are its negative and are ignored); x, y
             recomputed from lat/lon on the WGS84 local tangent plane; U = speed [kn] * 0.514444;
@@ -76,9 +83,10 @@ Canonical CSV (:meth:`Record.to_csv`, :meth:`Record.from_csv`, ``load(..., "cano
 
 Meta lines are ``# key: <JSON value>``; only present channels are written (columns
 ``time_s, delta_rad, psi_rad, r_rad_s`` required; ``x_m, y_m, u_m_s, v_m_s, U_m_s, azimuth_rad,
-rpm`` optional); numbers have 17 significant digits so the round trip is exact. A canonical file
-is trusted to be processed: on reading only the time (duplicates, quantisation), empty rows,
-irregular sampling (unless already flagged) and a wrapped psi are checked.
+rpm, thrust_N, wind_speed_m_s, wind_angle_rad`` optional); numbers have 17 significant digits so
+the round trip is exact. A canonical file is trusted to be processed: on reading only the time
+(duplicates, quantisation), empty rows, irregular sampling (unless already flagged), a wrapped
+psi and a wind angle outside (-pi, pi] (re-wrapped) are checked.
 """
 
 from __future__ import annotations
@@ -139,9 +147,13 @@ _CANONICAL_COLUMNS: dict[str, str] = {
     "U_m_s": "U",
     "azimuth_rad": "azimuth",
     "rpm": "rpm",
+    "thrust_N": "thrust",
+    "wind_speed_m_s": "wind_speed",
+    "wind_angle_rad": "wind_angle",
 }
 _REQUIRED = ("time", "delta", "psi", "r")
-_OPTIONAL = ("x", "y", "u", "v", "U", "azimuth", "rpm")
+_OPTIONAL = ("x", "y", "u", "v", "U", "azimuth", "rpm", "thrust", "wind_speed", "wind_angle")
+_ANGLE_CHANNELS = ("wind_angle",)  # wrapped to (-pi, pi]; psi is continuous instead
 _CANONICAL_MAGIC = "# shipgym canonical record v1"
 
 
@@ -159,6 +171,15 @@ def _warn(meta: dict[str, Any], message: str) -> None:
 def _ssa(a: np.ndarray) -> np.ndarray:
     """Smallest signed angle, as ``shipgym.models.ssa``: wrap to [-pi, pi)."""
     return np.mod(a + np.pi, 2.0 * np.pi) - np.pi
+
+
+def _wrap_angle(a: np.ndarray) -> np.ndarray:
+    """Wrap to (-pi, pi] (the wind-angle convention); values already inside are kept bit for bit."""
+    a = np.asarray(a, dtype=np.float64)
+    outside = (a <= -np.pi) | (a > np.pi)
+    wrapped = np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+    wrapped = np.where(wrapped <= -np.pi, wrapped + 2.0 * np.pi, wrapped)  # mod rounding to 2 pi
+    return np.where(outside, wrapped, a)
 
 
 def _jsonable(meta: dict[str, Any]) -> dict[str, Any]:
@@ -207,6 +228,15 @@ class Record:
         Pod azimuth [rad] with the pods' own sign (positive turns the ship to PORT).
     rpm : numpy.ndarray or None
         Propeller speed [rev/min] (for the Gunnerus: the rpm order).
+    thrust : numpy.ndarray or None
+        Measured total propeller thrust [N].
+    wind_speed : numpy.ndarray or None
+        Apparent (relative) wind speed at the ship [m/s], >= 0.
+    wind_angle : numpy.ndarray or None
+        Apparent (relative) wind angle of attack [rad]: the direction the wind comes FROM,
+        measured from the bow, positive clockwise (to starboard), wrapped to (-pi, pi]. So
+        0 = head wind, +pi/2 = wind from starboard (it pushes the ship to port), pi = wind from
+        astern. The apparent wind is the true wind minus the ship's velocity over ground.
     meta : dict
         JSON-serialisable description: ``source``, ``file``, ``vessel``, ``L`` [m] or None,
         ``scale`` ("model"/"full"), ``conversions`` (list of str), ``repairs`` (list of str),
@@ -224,6 +254,9 @@ class Record:
     U: np.ndarray | None = None
     azimuth: np.ndarray | None = None
     rpm: np.ndarray | None = None
+    thrust: np.ndarray | None = None
+    wind_speed: np.ndarray | None = None
+    wind_angle: np.ndarray | None = None
     meta: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -246,6 +279,17 @@ class Record:
             if not np.all(np.isfinite(arr)):
                 bad = int(np.flatnonzero(~np.isfinite(arr))[0])
                 raise ValueError(f"Record.{name} has a non-finite value at sample {bad}")
+            if name in _ANGLE_CHANNELS and np.any((arr <= -np.pi) | (arr > np.pi)):
+                bad = int(np.flatnonzero((arr <= -np.pi) | (arr > np.pi))[0])
+                raise ValueError(
+                    f"Record.{name} must be wrapped to (-pi, pi] rad, got {arr[bad]!r} at sample"
+                    f" {bad}"
+                )
+            if name == "wind_speed" and np.any(arr < 0.0):
+                bad = int(np.flatnonzero(arr < 0.0)[0])
+                raise ValueError(
+                    f"Record.wind_speed must be >= 0 m/s, got {arr[bad]!r} at sample {bad}"
+                )
             setattr(self, name, arr)
         if n is None or n < 2:
             raise ValueError(f"a Record needs at least 2 samples, got {n}")
@@ -317,8 +361,9 @@ class Record:
         Linear interpolation is exact for piecewise-linear signals and does not overshoot; it
         does low-pass filter when downsampling only as much as the dropped samples are ignored
         (no anti-alias filter is applied: filter first if ``dt`` is much larger than
-        :attr:`dt`). ``psi`` is continuous, so interpolating it is safe. The result records
-        ``meta["resampled_dt"]``.
+        :attr:`dt`). ``psi`` is continuous, so interpolating it is safe; ``wind_angle`` is
+        wrapped, so it is unwrapped, interpolated and wrapped again to (-pi, pi]. The result
+        records ``meta["resampled_dt"]``.
 
         Parameters
         ----------
@@ -333,10 +378,14 @@ class Record:
             )
         k = math.floor(self.duration / dt + 1e-9)
         t_new = self.time[0] + dt * np.arange(k + 1)
-        chans = {
-            name: (t_new if name == "time" else np.interp(t_new, self.time, value))
-            for name, value in self.channels().items()
-        }
+        chans: dict[str, np.ndarray] = {}
+        for name, value in self.channels().items():
+            if name == "time":
+                chans[name] = t_new
+            elif name in _ANGLE_CHANNELS:
+                chans[name] = _wrap_angle(np.interp(t_new, self.time, np.unwrap(value)))
+            else:
+                chans[name] = np.interp(t_new, self.time, value)
         meta = dict(self.meta)
         meta["resampled_dt"] = float(dt)
         meta.pop("irregular_sampling", None)
@@ -790,7 +839,7 @@ def _load_hsva(path: Path) -> Record:
     )
     data, n_empty = _parse_table(lines[4:], None, 12, path, 5)
     _drop_empty(n_empty, meta)
-    _drop_nan_rows(data, range(10), meta)
+    _drop_nan_rows(data, range(11), meta)
     t, data = _repair_time(data[:, 0], data, meta)
     deg = np.pi / 180.0
     r = data[:, 6] * deg
@@ -802,6 +851,7 @@ def _load_hsva(path: Path) -> Record:
         "delta negated (report: positive = steering to port side)",
         "earth-fixed dx0/dt, dy0/dt rotated into body u, v",
         "rpm = 60 * n [rps]",
+        "thrust [N] from column 11 (total propeller thrust, model scale)",
     ]
     meta["r_source"] = "measured"
     _rudder_offset(t, delta, meta)
@@ -817,6 +867,7 @@ def _load_hsva(path: Path) -> Record:
         v=v,
         U=np.hypot(data[:, 4], data[:, 5]),
         rpm=60.0 * data[:, 9],
+        thrust=data[:, 10],
         meta=meta,
     )
 
@@ -832,6 +883,7 @@ _ESSO_COLS = [
     "n_prop [rps]",
     "delta_rudder [rad]",
 ]
+_ESSO_WIND_COLS = ["wind_velo_relative_mid [m/s]", "wind_dir_relative_mid [rad]"]
 
 
 def _load_esso(path: Path) -> Record:
@@ -849,7 +901,9 @@ def _load_esso(path: Path) -> Record:
     )
     data, n_empty = _parse_table(lines[1:], ",", len(cols), path, 2)
     _drop_empty(n_empty, meta)
-    _drop_nan_rows(data, [ix[c] for c in _ESSO_COLS], meta)
+    has_wind = all(c in ix for c in _ESSO_WIND_COLS)
+    used = _ESSO_COLS + (_ESSO_WIND_COLS if has_wind else [])
+    _drop_nan_rows(data, [ix[c] for c in used], meta)
     t, data = _repair_time(data[:, ix["t [s]"]], data, meta)
     r = data[:, ix["r_angvelo [rad/s]"]]
     psi = _repair_heading(t, data[:, ix["psi_hat [rad]"]], r, meta)
@@ -858,9 +912,25 @@ def _load_esso(path: Path) -> Record:
     u, v = data[:, ix["u_velo [m/s]"]], data[:, ix["vm_velo [m/s]"]]
     meta["conversions"] += ["none for delta (MMG: positive = starboard turn)", "rpm = 60 * n"]
     meta["r_source"] = "measured"
-    meta["notes"] += [
-        "real wind of the order of the ship speed (wind channels not loaded)",
-    ]
+    wind_speed = wind_angle = None
+    if has_wind:
+        wind_speed = data[:, ix["wind_velo_relative_mid [m/s]"]]
+        wind_angle = _wrap_angle(data[:, ix["wind_dir_relative_mid [rad]"]])
+        meta["conversions"].append(
+            "wind_speed = wind_velo_relative_mid; wind_angle = wind_dir_relative_mid wrapped from"
+            " [0, 2 pi) to (-pi, pi]: the source angle is already the apparent wind direction"
+            " the wind comes FROM, clockwise from the bow (verified: apparent wind rebuilt from"
+            " wind_velo_true / wind_dir_true (from, clockwise from x0) minus the ship velocity"
+            " u, v rotated by psi matches within 0.04 deg RMS and 0.001 m/s RMS)"
+        )
+        meta["notes"].append(
+            "real wind of the order of the ship speed or larger; the apparent (relative) wind at"
+            " midship is loaded as wind_speed, wind_angle (true wind not loaded)"
+        )
+    else:
+        meta["notes"].append(
+            "real wind of the order of the ship speed (no apparent-wind columns in this file)"
+        )
     kind = path.parent.name
     if kind in ("zigzag", "turning") or path.name.startswith(("zigzag", "turn")):
         active = np.flatnonzero(np.abs(delta) > math.radians(10.0))
@@ -885,6 +955,8 @@ def _load_esso(path: Path) -> Record:
         v=v,
         U=np.hypot(u, v),
         rpm=60.0 * n_prop,
+        wind_speed=wind_speed,
+        wind_angle=wind_angle,
         meta=meta,
     )
 
@@ -1041,6 +1113,11 @@ def _load_canonical(path: Path) -> Record:
     if np.any(np.abs(np.diff(psi)) > np.pi):
         chans["psi"] = psi[0] + np.concatenate(([0.0], np.cumsum(_ssa(np.diff(psi)))))
         _warn(meta, "psi was wrapped (jumps > pi); unwrapped to a continuous heading")
+    for name in _ANGLE_CHANNELS:
+        angle = chans.get(name)
+        if angle is not None and np.any((angle <= -np.pi) | (angle > np.pi)):
+            chans[name] = _wrap_angle(angle)
+            _warn(meta, f"{name} outside (-pi, pi]; wrapped to (-pi, pi]")
     if meta.get("irregular_sampling") is not True:
         _flag_irregular(t, meta)
     if not named:

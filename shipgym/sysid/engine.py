@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
@@ -134,7 +134,7 @@ def _try(family: ModelFamily, ctx: Any, current: Candidate, name: str) -> Candid
 
 
 def identify(
-    record: Record,
+    record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
     *,
     holdout: float = 0.3,
@@ -146,8 +146,9 @@ def identify(
 
     Parameters
     ----------
-    record : Record
-        A manoeuvre record. The Nomoto family needs ``time``, ``delta``, ``psi``, ``r`` (``x``,
+    record : Record or sequence of Record
+        A manoeuvre record, or several runs of one ship for a family that cross-validates
+        across runs (``vmm:<term set>``: fitted on some runs, scored on the others). The Nomoto family needs ``time``, ``delta``, ``psi``, ``r`` (``x``,
         ``y`` and a speed enable its ``current`` effect); ``rvg3dof`` needs ``rpm``, the
         azimuth order, positions and speeds, as in the Gunnerus sea trials.
     model : str or ModelFamily
@@ -175,9 +176,18 @@ def identify(
         to split or lacking the channels the model needs.
     """
     t_start = time.perf_counter()
-    if not isinstance(record, Record):
-        raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(record).__name__}")
     family = model if isinstance(model, ModelFamily) else get_family(model)
+    runs = list(record) if isinstance(record, list | tuple) else [record]
+    for rec in runs:
+        if not isinstance(rec, Record):
+            raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(rec).__name__}")
+    if not runs:
+        raise ValueError("identify needs at least one record")
+    if len(runs) > 1 and not family.multi_run:
+        raise ValueError(
+            f"model {family.name!r} is fitted to one record at a time, got {len(runs)}; the "
+            "3-DOF models vmm:<term set> take several runs of one ship"
+        )
     model_name = model if isinstance(model, str) else family.name
     if not (
         isinstance(holdout, int | float)
@@ -189,10 +199,11 @@ def identify(
         isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0
     ):
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
-    t = record.time
-    window = family.resolve_window(window_s, float(t[-1] - t[0]))
+    window = family.resolve_window(
+        window_s, max(float(r.time[-1] - r.time[0]) for r in runs)
+    )
     say = progress or (lambda _msg: None)
-    ctx = family.prepare(record, float(holdout), window)
+    ctx = family.prepare(runs if family.multi_run else runs[0], float(holdout), window)
 
     t0 = time.perf_counter()
     base = current = family.fit_base(ctx, say)

@@ -131,6 +131,8 @@ class ModelFamily(ABC):
     default_window_s: float | None = None
     #: True when ``try_effect`` calls share no state, so the engine may run them in threads.
     concurrent_candidates: bool = False
+    #: True when ``prepare`` takes a list of runs of one ship (cross-validation across runs).
+    multi_run: bool = False
 
     def resolve_window(self, window_s: float | str | None, duration: float) -> float | None:
         """The scoring window [s] for ``window_s`` (``"auto"``: :attr:`default_window_s`)."""
@@ -147,9 +149,11 @@ class ModelFamily(ABC):
         return float(window_s)
 
     @abstractmethod
-    def prepare(self, record: Record, holdout: float, window_s: float | None) -> Any:
+    def prepare(
+        self, record: Record | list[Record], holdout: float, window_s: float | None
+    ) -> Any:
         """Check ``record`` (``ValueError`` naming what is missing) and split it; returns the
-        context every other method receives."""
+        context every other method receives. A :attr:`multi_run` family gets a list of runs."""
 
     @abstractmethod
     def fit_base(self, ctx: Any, say: Callable[[str], None]) -> Candidate:

@@ -1,0 +1,483 @@
+"""Seed 003's general 3-DOF vessel manoeuvring model (VMM) with polynomial hydrodynamics.
+
+The general manoeuvring model of seed 003 (Fossen 2021; Alexandersson's "Vessel Manoeuvring
+Models"), of which the Abkowitz, Norrbin and the seed's simplified models are special cases::
+
+    (M_RB + M_A) nu' + C_RB(nu) nu + C_A(nu_r) nu_r = [X_D, Y_D, N_D](u, v, r, delta, thrust)
+
+with ``nu = [u, v, r]`` at the origin (midship), the centre of gravity ``x_G`` forward of it::
+
+    M_RB = [[m, 0, 0], [0, m, m x_G], [0, m x_G, I_z]]
+    M_A  = -[[X_u', 0, 0], [0, Y_v', Y_r'], [0, N_v', N_r']]       (dotted derivatives)
+    C_RB nu = [-m (v r + x_G r^2), m u r, m x_G u r]
+    C_A nu  = [(Y_v' v + Y_r' r) r, -X_u' u r, -(Y_v' v + Y_r' r) u + X_u' u v]
+
+(the seed's ``eq_system`` with ``C_A`` written out; ``include_c_a=False`` lumps it into the
+hydrodynamic polynomials, as the seed's printed system does). Solved for the accelerations by
+the inverse of the constant mass matrix (the seed's ``S`` is its determinant).
+
+Hydrodynamics: the prime system
+-------------------------------
+``X_D``, ``Y_D``, ``N_D`` are sums of named terms, each a non-dimensional coefficient times a
+monomial of the primed motions (Norrbin's prime system, as in the seed's code): with the
+instantaneous speed through the water ``U = sqrt(u_r^2 + v_r^2)``::
+
+    u' = u_r / U,  v' = v_r / U,  r' = r L / U,  T' = T / (rho/2 L^2 U^2)
+    X_D = rho/2 L^2 U^2 sum_k X_k m_k(u', v', r', delta, T', ...),  N_D = rho/2 L^3 U^2 (...)
+
+so the coefficients are the same for the model and the full-scale ship (Froude scaling keeps
+every primed quantity; :meth:`VMMParams.scaled` scales the particulars only). A term's name is
+its equation and its factors: ``Y_vvr`` is ``Y_vvr v'^2 r'``; the factors are ``u v r d T``
+(``d`` the rudder angle, ``T`` the thrust), ``|v| |r| |d|`` (moduli, Norrbin's terms), the
+apparent-wind factors ``wc ws w2`` (``(V_w / U)^2`` times ``cos(g)``, ``sin(g)``, ``sin(2 g)``
+of the apparent wind angle ``g``, wind from ahead ``g = 0``, from starboard ``+pi/2``) and
+``0`` for a constant. Below :data:`MIN_SPEED_FRACTION` of the approach speed the primes use
+that floor (a polynomial model in the prime system is singular at ``U = 0``).
+
+Named term sets (:data:`TERM_SETS`): ``linear``; ``abkowitz`` (Abkowitz's third-order Taylor
+expansion with thrust, the seed's AVMM), ``martin`` and ``martin_simple`` (the seed's simplified
+models; the latter is its MAVMM), as in the seed author's ``VesselManoeuvringModels``
+(``vmm_linear``, ``vmm_abkowitz``, ``vmm_martin``, ``vmm_martin_simple``); ``norrbin3``
+(Norrbin's second-order modulus terms). The author's ``linear`` set has no thrust term and
+linearised rigid-body equations; here it keeps ``X_T T'`` (without it no straight-running
+equilibrium exists) and the full rigid-body terms.
+
+Thrust is an input, as in the seed's model tests: the measured propeller thrust [N], or, for a
+record with propeller revolutions only, the propeller loading ``rho D^4 n |n|`` [N]
+(:func:`propeller_loading`; the mean ``K_T (1 - t)`` is then part of ``X_T``).
+
+One derivative (:func:`vmm_row`) serves every term set: the terms are rows of a coefficient
+table packed into the parameter vector (:func:`pack_vmm`), read by one loop; nothing is
+generated per term set. Current: constant and irrotational, the hydrodynamics in the velocities
+relative to the water as in :mod:`shipgym.models.mmg`. Steering gear as in the MMG model; with
+``direct_rudder`` the rudder state is not integrated and the input is the rudder angle itself
+(the measured rudder of a record, as the seed's identification uses it).
+
+State ``[x, y, psi, u, v, r, delta]`` [m, m, rad, m/s, m/s, rad/s, rad]; input
+``[delta_c, thrust, wind_speed, wind_angle]`` [rad, N, m/s, rad] (the apparent wind).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from shipgym.models._jit import row_kernel
+from shipgym.models.kinematics import body_current, planar_kinematics
+
+__all__ = [
+    "FACTORS",
+    "MIN_SPEED_FRACTION",
+    "TERM_SETS",
+    "VMM_INPUTS",
+    "VMM_STATES",
+    "VMMParams",
+    "clarke_added_masses",
+    "pack_vmm",
+    "parse_term",
+    "propeller_loading",
+    "term_matrix",
+    "vmm_row",
+]
+
+VMM_STATES = ("x", "y", "psi", "u", "v", "r", "delta")
+VMM_INPUTS = ("delta_c", "thrust", "wind_speed", "wind_angle")
+IX, IY, IPSI, IU, IV, IR, IDELTA = range(7)
+
+FACTORS = ("u", "v", "r", "d", "T", "|v|", "|r|", "|d|", "wc", "ws", "w2")
+"""Factors of a term name, in the order of the packed exponents."""
+N_FACTORS = len(FACTORS)
+_TOKEN = re.compile(r"\|[vrd]\||w[cs2]|[uvrdT0]")
+
+MIN_SPEED_FRACTION = 0.1
+"""Floor of ``U`` in the primes, as a fraction of the approach speed."""
+
+_X = ("X_u", "X_uu", "X_rr", "X_vr", "X_dd", "X_T")
+TERM_SETS: dict[str, tuple[str, ...]] = {
+    "linear": (
+        "X_u", "X_v", "X_r", "X_d", "X_T",
+        "Y_u", "Y_v", "Y_r", "Y_d",
+        "N_u", "N_v", "N_r", "N_d",
+    ),
+    "abkowitz": (
+        "X_u", "X_uu", "X_uuu", "X_vv", "X_rr", "X_vr", "X_dd", "X_udd", "X_vd", "X_uvd",
+        "X_uvv", "X_urr", "X_uvr", "X_rd", "X_urd", "X_T",
+        *(f"{e}_{t}" for e in "YN" for t in (
+            "v", "r", "vvv", "vvr", "rrr", "vrr", "uuv", "uur", "uv", "ur", "d", "ddd", "ud",
+            "uud", "vdd", "vvd", "rdd", "rrd", "vrd", "Td", "T", "0", "0u", "0uu",
+        )),
+    ),
+    "martin": (
+        "X_u", "X_uu", "X_rr", "X_vr", "X_dd", "X_vd", "X_T",
+        *(f"{e}_{t}" for e in "YN" for t in ("v", "r", "u", "uv", "ur", "d", "vdd", "rdd")),
+    ),
+    "martin_simple": (
+        *_X,
+        *(f"{e}_{t}" for e in "YN" for t in ("v", "r", "u", "ur", "d", "Td", "T", "vvd")),
+    ),
+    "norrbin3": (
+        "X_u", "X_uu", "X_vv", "X_vr", "X_rr", "X_dd", "X_T",
+        *(f"{e}_{t}" for e in "YN" for t in ("u", "v", "r", "d", "v|v|", "|v|r", "v|r|", "r|r|")),
+    ),
+}  # fmt: skip
+"""Named term sets (module docstring)."""
+
+
+def parse_term(name: str) -> tuple[int, np.ndarray]:
+    """Equation (0 X, 1 Y, 2 N) and factor exponents of a term name such as ``"Y_vvr"``.
+
+    Raises
+    ------
+    ValueError
+        For a name that is not ``X_``, ``Y_`` or ``N_`` followed by factors of :data:`FACTORS`
+        (or ``0``).
+    """
+    if not isinstance(name, str) or len(name) < 3 or name[:2] not in ("X_", "Y_", "N_"):
+        raise ValueError(
+            f"term {name!r} must be X_, Y_ or N_ followed by factors {FACTORS} (e.g. 'Y_vvr')"
+        )
+    body = name[2:]
+    tokens = _TOKEN.findall(body)
+    if "".join(tokens) != body or ("0" in tokens and len(tokens) > 1 and tokens[0] != "0"):
+        raise ValueError(f"term {name!r}: cannot read {body!r} as factors {FACTORS} (or 0)")
+    e = np.zeros(N_FACTORS)
+    for tok in tokens:
+        if tok != "0":
+            e[FACTORS.index(tok)] += 1
+    return "XYN".index(name[0]), e
+
+
+def term_matrix(names: Sequence[str]) -> np.ndarray:
+    """``(n, 1 + N_FACTORS)`` table of equation index and exponents of the terms ``names``."""
+    out = np.zeros((len(names), 1 + N_FACTORS))
+    for k, name in enumerate(names):
+        eq, e = parse_term(name)
+        out[k, 0] = eq
+        out[k, 1:] = e
+    return out
+
+
+def propeller_loading(rps: np.ndarray, diameter: float, rho: float) -> np.ndarray:
+    """``rho D^4 n |n|`` [N]: the thrust input of a record with propeller revolutions only."""
+    n = np.asarray(rps, dtype=np.float64)
+    return rho * diameter**4 * n * np.abs(n)
+
+
+def clarke_added_masses(
+    length: float, breadth: float, draught: float, block_coefficient: float
+) -> dict[str, float]:
+    """Prime added masses of Clarke, Gedling and Hine (1982) (sway/yaw) and Xu' = -0.05 m'.
+
+    Returns ``{"X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot"}`` in the prime system
+    (forces over ``rho/2 L^3``, moments over ``rho/2 L^4`` and ``rho/2 L^5``). The surge value
+    is the usual 5 % of the mass of a full-form ship (Clarke gives no surge formula).
+    """
+    t_l, b_l, b_t, cb = draught / length, breadth / length, breadth / draught, block_coefficient
+    k = -math.pi * t_l**2
+    mass_prime = 2.0 * cb * b_l * t_l  # rho L B T Cb / (rho/2 L^3)
+    return {
+        "X_udot": -0.05 * mass_prime,
+        "Y_vdot": k * (1.0 + 0.16 * cb * b_t - 5.1 * b_l**2),
+        "Y_rdot": k * (0.67 * b_l - 0.0033 * b_t**2),
+        "N_vdot": k * (1.1 * b_l - 0.041 * b_t),
+        "N_rdot": k * (1.0 / 12.0 + 0.017 * cb * b_t - 0.33 * b_l),
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class VMMParams:
+    """A vessel manoeuvring model: particulars, added masses and hydrodynamic coefficients.
+
+    Attributes
+    ----------
+    coefficients : mapping
+        Term name -> prime coefficient (module docstring); the model's term set.
+    length, breadth, draught : float
+        ``L``, ``B``, ``T`` [m].
+    mass : float
+        ``m`` [kg].
+    x_g : float
+        Centre of gravity forward of the origin (midship) [m].
+    yaw_inertia : float
+        ``I_z`` about the centre of gravity [kg m^2] (the origin's is ``I_z + m x_G^2``).
+    added : mapping
+        Prime added masses ``X_udot, Y_vdot, Y_rdot, N_vdot, N_rdot`` (the seed's prime
+        system: over ``rho/2 L^3``, ``rho/2 L^4`` and ``rho/2 L^5``; negative).
+    approach_speed : float
+        Trial speed ``U_0`` [m/s] (manoeuvres; the floor of ``U`` in the primes).
+    propeller_diameter : float
+        ``D`` [m] (the loading ``rho D^4 n |n|`` of records without thrust).
+    rho : float
+        Water density [kg/m^3].
+    rudder_offset : float
+        Rudder angle the hydrodynamics see at zero rudder [rad] (identification effect).
+    max_rudder, rudder_rate, rudder_time_constant : float
+        Steering gear [rad, rad/s, s].
+    include_c_a : bool
+        Write the added-mass Coriolis terms ``C_A`` out (True) or leave them to the
+        polynomials.
+    direct_rudder : bool
+        The input ``delta_c`` is the rudder angle (no steering gear).
+    thrust_from : {"thrust", "rps"}
+        What the thrust input of the fitted records was (the measured thrust, or the loading
+        ``rho D^4 n |n|``).
+    name : str
+        Name of the model.
+    """
+
+    coefficients: Mapping[str, float]
+    length: float
+    breadth: float
+    draught: float
+    mass: float
+    x_g: float
+    yaw_inertia: float
+    added: Mapping[str, float]
+    approach_speed: float
+    propeller_diameter: float = 0.0
+    rho: float = 1025.0
+    rudder_offset: float = 0.0
+    max_rudder: float = math.radians(35.0)
+    rudder_rate: float = math.radians(15.8)
+    rudder_time_constant: float = 0.05
+    include_c_a: bool = True
+    direct_rudder: bool = False
+    thrust_from: str = "thrust"
+    name: str = "vmm"
+    terms: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        coeffs = {str(k): float(v) for k, v in dict(self.coefficients).items()}
+        object.__setattr__(self, "coefficients", coeffs)
+        object.__setattr__(self, "terms", term_matrix(list(coeffs)))
+        for k, v in coeffs.items():
+            if not math.isfinite(v):
+                raise ValueError(f"VMMParams coefficient {k} must be finite, got {v!r}")
+        for k in ("length", "breadth", "draught", "mass", "yaw_inertia", "approach_speed",
+                  "rho", "max_rudder", "rudder_rate", "rudder_time_constant"):  # fmt: skip
+            v = getattr(self, k)
+            if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+                raise ValueError(f"VMMParams.{k} must be a finite number > 0, got {v!r}")
+        added = {k: float(dict(self.added).get(k, 0.0)) for k in _ADDED}
+        object.__setattr__(self, "added", added)
+        if self.thrust_from not in ("thrust", "rps"):
+            raise ValueError(f"thrust_from must be 'thrust' or 'rps', got {self.thrust_from!r}")
+
+    @property
+    def term_names(self) -> tuple[str, ...]:
+        """The model's terms, in order."""
+        return tuple(self.coefficients)
+
+    def with_coefficients(self, coefficients: Mapping[str, float], **changes: Any) -> VMMParams:
+        """A copy with other coefficients (and any other field changed)."""
+        return replace(self, coefficients=dict(coefficients), **changes)
+
+    def scaled(self, factor: float) -> VMMParams:
+        """The geometrically similar ship ``factor`` times longer (Froude scaling; the prime
+        coefficients are kept)."""
+        if not (isinstance(factor, int | float) and math.isfinite(factor) and factor > 0):
+            raise ValueError(f"scale factor must be a finite number > 0, got {factor!r}")
+        s = math.sqrt(factor)
+        return replace(
+            self,
+            length=self.length * factor,
+            breadth=self.breadth * factor,
+            draught=self.draught * factor,
+            mass=self.mass * factor**3,
+            x_g=self.x_g * factor,
+            yaw_inertia=self.yaw_inertia * factor**5,
+            approach_speed=self.approach_speed * s,
+            propeller_diameter=self.propeller_diameter * factor,
+            rudder_rate=self.rudder_rate / s,
+            rudder_time_constant=self.rudder_time_constant * s,
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready description (:meth:`from_dict` reads it back)."""
+        out: dict[str, Any] = {
+            k: getattr(self, k)
+            for k in ("length", "breadth", "draught", "mass", "x_g", "yaw_inertia",
+                      "approach_speed", "propeller_diameter", "rho", "rudder_offset",
+                      "max_rudder", "rudder_rate", "rudder_time_constant", "include_c_a",
+                      "direct_rudder", "thrust_from", "name")  # fmt: skip
+        }
+        out["coefficients"] = dict(self.coefficients)
+        out["added"] = dict(self.added)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> VMMParams:
+        """The model described by :meth:`to_dict` (``ValueError`` naming a missing key)."""
+        try:
+            return cls(**{k: data[k] for k in _REQUIRED_KEYS}, **{
+                k: data[k] for k in _OPTIONAL_KEYS if k in data
+            })  # fmt: skip
+        except KeyError as exc:
+            raise ValueError(
+                f"a VMM description needs the keys {_REQUIRED_KEYS}; missing {exc}"
+            ) from None
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> VMMParams:
+        """The model in a JSON file: :meth:`to_dict`, or the ``"vmm"`` entry of a
+        ``shipgym identify --model vmm:... --json`` report."""
+        p = Path(path)
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"cannot read a VMM from {str(p)!r}: {exc}") from None
+        if isinstance(data, dict) and isinstance(data.get("vmm"), dict):
+            data = data["vmm"]
+        if not isinstance(data, dict):
+            raise ValueError(f"{str(p)!r} holds no VMM description (a JSON object)")
+        return cls.from_dict(data)
+
+    def approach_thrust(self) -> float:
+        """Thrust input [N] that holds straight running at the approach speed (from
+        :func:`vmm_row`)."""
+        from scipy.optimize import brentq
+
+        p = pack_vmm(replace(self, direct_rudder=True))
+        x = np.zeros(7)
+        x[IU] = self.approach_speed
+        out = np.empty(7)
+        c = np.zeros(2)
+
+        def surge(thrust: float) -> float:
+            vmm_row(x, np.array([0.0, thrust, 0.0, 0.0]), p, c, out)
+            return float(out[IU])
+
+        q = 0.5 * self.rho * self.length**2 * self.approach_speed**2
+        lo, hi = -10.0 * q, 10.0 * q
+        if surge(lo) * surge(hi) > 0:
+            raise ValueError("no thrust holds the approach speed with these coefficients")
+        return float(brentq(surge, lo, hi, xtol=1e-9 * q))
+
+
+_ADDED = ("X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot")
+_REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
+                  "yaw_inertia", "added", "approach_speed")  # fmt: skip
+_OPTIONAL_KEYS = ("propeller_diameter", "rho", "rudder_offset", "max_rudder", "rudder_rate",
+                  "rudder_time_constant", "include_c_a", "direct_rudder", "thrust_from", "name")  # fmt: skip
+
+# packed layout
+P_MU = 0  # m - X_udot
+P_INV = 1  # inverse of the 2x2 sway-yaw mass matrix (4 entries)
+P_M, P_MXG = 5, 6  # m, m x_G
+P_XUD, P_YVD, P_YRD = 7, 8, 9  # dimensional X_udot, Y_vdot, Y_rdot (C_A; 0 if not included)
+P_QX, P_QN, P_L = 10, 11, 12  # rho/2 L^2, rho/2 L^3, L
+P_UMIN = 13
+P_OFFSET = 14  # rudder offset [rad]
+P_GEAR = 15  # max rudder, rate, 1 / T_delta, direct (1.0) or not
+P_NTERMS = 19
+P_TERMS = 20  # then per term: coefficient, equation, exponents (N_FACTORS)
+TERM_WIDTH = 2 + N_FACTORS
+
+
+def pack_vmm(params: VMMParams) -> np.ndarray:
+    """Parameter vector that :func:`vmm_row` reads (the coefficient table at the end)."""
+    q = params
+    half_rho = 0.5 * q.rho
+    a = q.added
+    xud = a["X_udot"] * half_rho * q.length**3
+    yvd = a["Y_vdot"] * half_rho * q.length**3
+    yrd = a["Y_rdot"] * half_rho * q.length**4
+    nvd = a["N_vdot"] * half_rho * q.length**4
+    nrd = a["N_rdot"] * half_rho * q.length**5
+    m, mxg = q.mass, q.mass * q.x_g
+    iz0 = q.yaw_inertia + m * q.x_g**2
+    n_terms = len(q.coefficients)
+    p = np.zeros(P_TERMS + TERM_WIDTH * n_terms)
+    p[P_MU] = m - xud
+    mat = np.array([[m - yvd, mxg - yrd], [mxg - nvd, iz0 - nrd]])
+    p[P_INV : P_INV + 4] = np.linalg.inv(mat).ravel()
+    p[P_M], p[P_MXG] = m, mxg
+    if q.include_c_a:
+        p[P_XUD], p[P_YVD], p[P_YRD] = xud, yvd, yrd
+    p[P_QX], p[P_QN], p[P_L] = half_rho * q.length**2, half_rho * q.length**3, q.length
+    p[P_UMIN] = MIN_SPEED_FRACTION * q.approach_speed
+    p[P_OFFSET] = q.rudder_offset
+    p[P_GEAR : P_GEAR + 4] = (
+        q.max_rudder, q.rudder_rate, 1.0 / q.rudder_time_constant, float(q.direct_rudder),
+    )  # fmt: skip
+    p[P_NTERMS] = n_terms
+    block = p[P_TERMS:].reshape(n_terms, TERM_WIDTH)
+    block[:, 0] = list(q.coefficients.values())
+    block[:, 1:] = q.terms
+    return p
+
+
+@row_kernel
+def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
+    """``(X_D, Y_D, N_D)`` [N, N, N m] of the terms packed in ``p``."""
+    big_u = max(math.sqrt(u_r * u_r + v_r * v_r), p[P_UMIN])
+    length = p[P_L]
+    vp = v_r / big_u
+    rp = r * length / big_u
+    u2 = big_u * big_u
+    w2 = wind_speed * wind_speed / u2
+    f = (
+        u_r / big_u, vp, rp, delta, thrust / (p[P_QX] * u2), abs(vp), abs(rp), abs(delta),
+        w2 * math.cos(wind_angle), w2 * math.sin(wind_angle), w2 * math.sin(2.0 * wind_angle),
+    )  # fmt: skip
+    sx = 0.0
+    sy = 0.0
+    sn = 0.0
+    n_terms = int(p[P_NTERMS])
+    for k in range(n_terms):
+        b = P_TERMS + TERM_WIDTH * k
+        val = p[b]
+        for j in range(N_FACTORS):
+            e = int(p[b + 2 + j])
+            for _ in range(e):
+                val *= f[j]
+        eq = p[b + 1]
+        if eq == 0.0:
+            sx += val
+        elif eq == 1.0:
+            sy += val
+        else:
+            sn += val
+    return p[P_QX] * u2 * sx, p[P_QX] * u2 * sy, p[P_QN] * u2 * sn
+
+
+@row_kernel
+def vmm_row(x, u, p, c, out):
+    """State derivative of the VMM (module docstring; seed 003 ``eq_system``)."""
+    psi = x[IPSI]
+    cs = math.cos(psi)
+    sn = math.sin(psi)
+    ug = x[IU]
+    vg = x[IV]
+    r = x[IR]
+    planar_kinematics(ug, vg, r, cs, sn, out)
+    uc, vc = body_current(c, cs, sn)
+    ur = ug - uc
+    vr = vg - vc
+    g = P_GEAR
+    if p[g + 3] != 0.0:
+        delta = u[0]
+        out[IDELTA] = 0.0
+    else:
+        delta = x[IDELTA]
+        dc = min(max(u[0], -p[g]), p[g])
+        out[IDELTA] = min(max((dc - delta) * p[g + 2], -p[g + 1]), p[g + 1])
+    fx, fy, fn = vmm_forces(ur, vr, r, delta + p[P_OFFSET], u[1], u[2], u[3], p)
+    m = p[P_M]
+    mxg = p[P_MXG]
+    xud = p[P_XUD]
+    lin = p[P_YVD] * vr + p[P_YRD] * r  # Y_vdot v + Y_rdot r (C_A)
+    bx = fx + m * vr * r + mxg * r * r - lin * r
+    by = fy - m * ur * r + xud * ur * r
+    bn = fn - mxg * ur * r + lin * ur - xud * ur * vr
+    out[IU] = bx / p[P_MU] + r * vc
+    out[IV] = p[P_INV] * by + p[P_INV + 1] * bn - r * uc
+    out[IR] = p[P_INV + 2] * by + p[P_INV + 3] * bn

@@ -1,0 +1,919 @@
+"""Seed 003's general 3-DOF models (VMM) fitted to several runs of one ship.
+
+The seed's identification, through the one engine (:mod:`shipgym.sysid.engine`):
+
+1. **Inverse dynamics** (:func:`regress`). From the measured motions, smoothed and
+   differentiated by the loaders' filter (a local quadratic, Savitzky-Golay, over
+   :data:`FILTER_LENGTHS` ship lengths of travel), the motion equations of
+   :mod:`shipgym.models.vmm` give the hydrodynamic forces ``X_D, Y_D, N_D`` at every sample;
+   in the prime system they are linear in the coefficients of a term set, which ordinary least
+   squares estimates equation by equation. Collinear terms are found by a column-pivoted QR of
+   the column-normalised regressors: a term whose pivot is below :data:`COLLINEAR_RCOND` of the
+   first is reported with the terms it is nearly a combination of and left out (its coefficient
+   0), never silently kept. Standard errors are Newey-West (Bartlett) estimates with the filter
+   length as lag, since the residual of filtered derivatives is correlated over that length; the
+   condition number of the kept regressors is reported per equation.
+2. **Output-error refinement** (:func:`refine`): the regression result is the start of a
+   weighted least-squares fit of the simulated ``psi, r, u, v`` to the measurement, run by run
+   (windows of ``window_s`` for long runs, each from the measured state), as the Nomoto fits do.
+3. **Cross-validation across runs**: the engine fits on some runs and scores on the others
+   (:meth:`VMMFamily.prepare`: every ``1/holdout``-th run is held out; a single run is split in
+   time). Effects (:data:`VMM_EFFECTS`): ``rudder_offset`` (the hydrodynamic zero of the
+   rudder), ``current`` (a constant current, in the relative velocities), ``rudder_slipstream``
+   (rudder force growing with the propeller loading, ``Y_Td, N_Td``) and ``wind`` (the apparent
+   wind's surge force, side force and yaw moment, for records with wind channels: Esso Osaka).
+
+Particulars (mass, inertia, ``x_G``, added masses) come from :func:`vessel_params` for the
+records it knows (KVLCC2 at HSVA and MARIN; Esso Osaka), or from the caller's
+:class:`~shipgym.models.vmm.VMMParams`; the regression does not estimate the added masses (the
+accelerations of free-running manoeuvres are too small and too correlated with the velocities).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from scipy.linalg import qr
+from scipy.optimize import least_squares
+from scipy.signal import savgol_filter
+
+from shipgym.models._jit import kernel, row_kernel
+from shipgym.models.integrate import rk4_stages
+from shipgym.models.mmg import KVLCC2_SCALE, MMGParams
+from shipgym.models.vmm import (
+    TERM_SETS,
+    VMMParams,
+    clarke_added_masses,
+    pack_vmm,
+    propeller_loading,
+    term_matrix,
+    vmm_row,
+)
+from shipgym.sysid.data import Record
+from shipgym.sysid.families.base import (
+    Candidate,
+    Effect,
+    ModelFamily,
+    bic,
+    register,
+    window_starts,
+    wrap,
+)
+
+__all__ = [
+    "COLLINEAR_RCOND",
+    "FILTER_LENGTHS",
+    "VMM_EFFECTS",
+    "RegressionResult",
+    "VMMFamily",
+    "VMMFit",
+    "prepare_runs",
+    "refine",
+    "regress",
+    "replay",
+    "vessel_params",
+]
+
+FILTER_LENGTHS = 0.15
+"""Smoothing and differentiation window of the inverse dynamics, in ship lengths of travel
+(``0.15 L / U``: 0.9 s on the 7 m KVLCC2 model, 6 s at full scale)."""
+
+COLLINEAR_RCOND = 1e-3
+"""Relative pivot below which a term is collinear with the kept ones (normalised columns)."""
+
+STEP_LENGTHS = 0.03
+"""Replay step of the output-error fits, in ship lengths of travel (the record is thinned to
+about this step: 0.18 s on the 7 m model at 1.18 m/s)."""
+
+VMM_MIN_RELATIVE_DROP = 0.05
+"""Required relative drop of the held-out error (geometric mean of ``psi, r, u, v``)."""
+
+_CHANNELS = ("psi", "r", "u", "v")
+_STATE_COL = {"x": 0, "y": 1, "psi": 2, "u": 3, "v": 4, "r": 5}
+
+VMM_EFFECTS: dict[str, Effect] = {
+    "rudder_offset": Effect(
+        "rudder_offset",
+        "delta -> delta + delta_0 in every term",
+        ("delta_0",),
+        {"delta_0": (-math.radians(5.0), math.radians(5.0))},
+        "propeller-induced asymmetry and a rudder zero error; the MARIN KVLCC2 runs hold about "
+        "-0.8 deg of rudder to run straight",
+    ),
+    "current": Effect(
+        "current",
+        "hydrodynamics in nu - nu_c, nu_c = R(psi)^T [V_x, V_y] (seed 003 eq_nu_r)",
+        ("V_x", "V_y"),
+        {"V_x": (-2.0, 2.0), "V_y": (-2.0, 2.0)},
+        "a constant, irrotational current (seed 003)",
+    ),
+    "rudder_slipstream": Effect(
+        "rudder_slipstream",
+        "Y_Td T' delta, N_Td T' delta",
+        ("Y_Td", "N_Td"),
+        {},
+        "the rudder in the propeller slipstream: its force grows with the thrust loading (MMG "
+        "eq. 40-42; the seed's Y_thrustdelta)",
+    ),
+    "wind": Effect(
+        "wind",
+        "X_wc (V_w/U)^2 cos g, Y_ws (V_w/U)^2 sin g, N_w2 (V_w/U)^2 sin 2g",
+        ("X_wc", "Y_ws", "N_w2"),
+        {},
+        "apparent-wind loads with the angular forms of Isherwood (1972) and Fossen (2011, "
+        "eq. 8.23); needs the record's wind channels",
+    ),
+}
+"""The effects of the VMM family (module docstring)."""
+
+_EFFECT_TERMS = {"rudder_slipstream": ("Y_Td", "N_Td"), "wind": ("X_wc", "Y_ws", "N_w2")}
+
+
+# --------------------------------------------------------------------------------------------
+# particulars of the ships the project's records come from
+
+
+def _kvlcc2(length: float) -> VMMParams:
+    """KVLCC2 particulars (HSVA report: INSEAN model 2487) at ``length``, added masses of
+    Yasukawa and Yoshimura (2015) in the seed's prime system."""
+    mmg = MMGParams.kvlcc2()
+    d_l = 0.455 / 7.0
+    base = VMMParams(
+        coefficients={},
+        length=7.0,
+        breadth=1.2688,
+        draught=0.455,
+        mass=3272.0,
+        x_g=0.0348 * 7.0,
+        yaw_inertia=3272.0 * (0.25 * 7.0) ** 2,
+        added={
+            "X_udot": -mmg.m_x * d_l,
+            "Y_vdot": -mmg.m_y * d_l,
+            "N_rdot": -mmg.j_z * d_l,
+        },
+        approach_speed=1.179,
+        propeller_diameter=0.204,
+        rho=1000.0,
+        rudder_rate=math.radians(15.8),
+        name="KVLCC2",
+    )
+    return base.scaled(length / 7.0) if length != 7.0 else base
+
+
+def _esso_osaka() -> VMMParams:
+    """Esso Osaka 3 m model (Osaka Univ., SOURCES.md): measured mass and ``x_G``, yaw radius
+    of gyration 0.25 L (assumed), Clarke's added masses with ``C_b`` 0.83."""
+    return VMMParams(
+        coefficients={},
+        length=3.0,
+        breadth=0.489,
+        draught=0.201,
+        mass=244.6,
+        x_g=0.094,
+        yaw_inertia=244.6 * (0.25 * 3.0) ** 2,
+        added=clarke_added_masses(3.0, 0.489, 0.201, 0.83),
+        approach_speed=0.4,
+        propeller_diameter=0.084,
+        rho=1000.0,
+        rudder_rate=math.radians(20.0),
+        name="Esso Osaka",
+    )
+
+
+def vessel_params(record: Record) -> VMMParams:
+    """Particulars (no coefficients) of the ship of a record from a known source.
+
+    Raises
+    ------
+    ValueError
+        For a record of another ship: pass ``particulars=VMMParams(...)`` to
+        :class:`VMMFamily` then.
+    """
+    source = record.meta.get("source")
+    if source == "hsva":
+        return _kvlcc2(7.0)
+    if source == "marin":
+        return _kvlcc2(7.0 * KVLCC2_SCALE)
+    if source == "esso_osaka":
+        return _esso_osaka()
+    raise ValueError(
+        f"no particulars known for a {source!r} record ({record.meta.get('vessel')}); the "
+        "3-DOF models need mass, inertia, x_G and added masses: pass "
+        "particulars=shipgym.models.VMMParams(...) (known: hsva, marin, esso_osaka records)"
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# records prepared for regression and replay
+
+
+@dataclass
+class _Run:
+    """One record prepared: smoothed states, their derivatives and the model inputs."""
+
+    name: str
+    t: np.ndarray
+    states: np.ndarray  # (n, 6) x, y, psi, u, v, r (smoothed; u, v over ground)
+    accel: np.ndarray  # (n, 3) u', v', r'
+    delta: np.ndarray
+    thrust: np.ndarray
+    wind: np.ndarray  # (n, 2) apparent wind speed, angle (zeros without wind channels)
+    has_wind: bool
+    measured: np.ndarray  # (n, 6) the record's own values
+
+
+def _cut(record: Record) -> Record:
+    """The part of a record that is a manoeuvre (Esso Osaka: ``manoeuvre_start_s`` ..
+    ``manoeuvre_end_s``)."""
+    t0 = record.meta.get("manoeuvre_start_s")
+    t1 = record.meta.get("manoeuvre_end_s")
+    if t0 is None or t1 is None:
+        return record
+    return record.slice(float(t0), float(t1))
+
+
+def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
+    """Smooth and differentiate every record over :data:`FILTER_LENGTHS` ship lengths.
+
+    Raises
+    ------
+    ValueError
+        For a record without positions, body velocities or any propulsion channel, or with an
+        irregular time step.
+    """
+    runs = []
+    for rec in records:
+        rec = _cut(rec)
+        name = str(rec.meta.get("file") or rec.meta.get("source") or f"run {len(runs)}")
+        missing = [k for k in ("x", "y", "u", "v") if getattr(rec, k) is None]
+        if missing:
+            raise ValueError(
+                f"{name}: 3-DOF identification needs the channels x, y, u, v (and thrust or "
+                f"rpm); missing: {', '.join(missing)}"
+            )
+        dt = np.diff(rec.time)
+        h = float(np.median(dt))
+        if np.max(np.abs(dt - h)) > 0.01 * h:
+            raise ValueError(f"{name}: the time step must be uniform (resample the record first)")
+        if rec.thrust is not None:
+            thrust = rec.thrust
+            if params.thrust_from != "thrust":
+                raise ValueError(f"{name}: has thrust, but the model's thrust input is rps")
+        elif rec.rpm is not None:
+            if params.propeller_diameter <= 0:
+                raise ValueError(f"{name}: rpm only, and the particulars have no propeller")
+            thrust = propeller_loading(rec.rpm / 60.0, params.propeller_diameter, params.rho)
+        else:
+            raise ValueError(f"{name}: 3-DOF identification needs a thrust or rpm channel")
+        speed = float(np.median(np.hypot(rec.u, rec.v)))
+        w = int(round(FILTER_LENGTHS * params.length / max(speed, 1e-3) / h)) // 2 * 2 + 1
+        w = max(w, 5)
+        if rec.n < 3 * w:
+            raise ValueError(f"{name}: too short ({rec.n} samples) for a {w}-sample filter")
+        meas = np.column_stack((rec.x, rec.y, rec.psi, rec.u, rec.v, rec.r))
+        states = savgol_filter(meas, w, 2, axis=0)
+        accel = savgol_filter(meas[:, 3:6], w, 2, deriv=1, delta=h, axis=0)
+        has_wind = rec.wind_speed is not None and rec.wind_angle is not None
+        wind = (
+            np.column_stack((rec.wind_speed, rec.wind_angle))
+            if has_wind
+            else np.zeros((rec.n, 2))
+        )
+        runs.append(
+            _Run(name, rec.time, states, accel, rec.delta, np.asarray(thrust), wind, has_wind,
+                 meas)  # fmt: skip
+        )
+    return runs
+
+
+# --------------------------------------------------------------------------------------------
+# inverse dynamics and regression
+
+
+def _monomials(terms: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """``(n, k)`` monomials of the term table ``terms`` at the factors ``f`` ``(n, 11)``."""
+    out = np.ones((f.shape[0], terms.shape[0]))
+    for k in range(terms.shape[0]):
+        for j, e in enumerate(terms[k, 1:]):
+            if e:
+                out[:, k] *= f[:, j] ** int(e)
+    return out
+
+
+def _factors(
+    run: _Run, params: VMMParams, delta_0: float, current: Sequence[float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Prime factors ``(n, 11)``, ``U``, and the relative velocities ``u_r, v_r``."""
+    psi = run.states[:, 2]
+    cs, sn = np.cos(psi), np.sin(psi)
+    uc = current[0] * cs + current[1] * sn
+    vc = -current[0] * sn + current[1] * cs
+    ur = run.states[:, 3] - uc
+    vr = run.states[:, 4] - vc
+    big_u = np.maximum(np.hypot(ur, vr), 0.1 * params.approach_speed)
+    u2 = big_u**2
+    vp = vr / big_u
+    rp = run.states[:, 5] * params.length / big_u
+    d = run.delta + delta_0
+    w2 = run.wind[:, 0] ** 2 / u2
+    g = run.wind[:, 1]
+    f = np.column_stack((
+        ur / big_u, vp, rp, d, run.thrust / (0.5 * params.rho * params.length**2 * u2),
+        np.abs(vp), np.abs(rp), np.abs(d), w2 * np.cos(g), w2 * np.sin(g), w2 * np.sin(2 * g),
+    ))  # fmt: skip
+    return f, big_u, ur, vr
+
+
+def _forces(
+    run: _Run, params: VMMParams, current: Sequence[float], ur: np.ndarray, vr: np.ndarray
+) -> np.ndarray:
+    """``(n, 3)`` hydrodynamic forces ``X_D, Y_D, N_D`` by inverse dynamics (the motion
+    equations of :func:`~shipgym.models.vmm.vmm_row` solved for the forces)."""
+    p = pack_vmm(replace(params, coefficients={}))
+    from shipgym.models import vmm as v
+
+    r = run.states[:, 5]
+    psi = run.states[:, 2]
+    uc = current[0] * np.cos(psi) + current[1] * np.sin(psi)
+    vc = -current[0] * np.sin(psi) + current[1] * np.cos(psi)
+    dur = run.accel[:, 0] - r * vc  # relative accelerations (constant current)
+    dvr = run.accel[:, 1] + r * uc
+    dr = run.accel[:, 2]
+    m, mxg, xud = p[v.P_M], p[v.P_MXG], p[v.P_XUD]
+    lin = p[v.P_YVD] * vr + p[v.P_YRD] * r
+    minv = p[v.P_INV : v.P_INV + 4].reshape(2, 2)
+    mat = np.linalg.inv(minv)
+    fx = p[v.P_MU] * dur - (m * vr * r + mxg * r * r - lin * r)
+    by = mat[0, 0] * dvr + mat[0, 1] * dr
+    bn = mat[1, 0] * dvr + mat[1, 1] * dr
+    fy = by - (-m * ur * r + xud * ur * r)
+    fn = bn - (-mxg * ur * r + lin * ur - xud * ur * vr)
+    return np.column_stack((fx, fy, fn))
+
+
+@dataclass
+class RegressionResult:
+    """Inverse-dynamics regression of one term set.
+
+    Attributes
+    ----------
+    coefficients : dict
+        Term -> prime coefficient (0 for the collinear terms left out).
+    stderr : dict
+        Term -> Newey-West standard error (NaN for the terms left out).
+    collinear : dict
+        Left-out term -> the kept terms it is nearly a combination of.
+    condition : dict
+        Equation (``X``, ``Y``, ``N``) -> condition number of its kept, normalised regressors.
+    r2 : dict
+        Equation -> coefficient of determination of the prime forces.
+    n : int
+        Samples used.
+    """
+
+    coefficients: dict[str, float]
+    stderr: dict[str, float]
+    collinear: dict[str, list[str]]
+    condition: dict[str, float]
+    r2: dict[str, float]
+    n: int
+
+
+def _newey_west(a: np.ndarray, e: np.ndarray, segments: list[slice], lag: int) -> np.ndarray:
+    """Newey-West (Bartlett) covariance of OLS coefficients; lags stay within a run."""
+    ata_inv = np.linalg.pinv(a.T @ a)
+    z = a * e[:, None]
+    s = z.T @ z
+    for lag_k in range(1, lag + 1):
+        wk = 1.0 - lag_k / (lag + 1.0)
+        g = np.zeros_like(s)
+        for sl in segments:
+            zz = z[sl]
+            if zz.shape[0] > lag_k:
+                g += zz[lag_k:].T @ zz[:-lag_k]
+        s += wk * (g + g.T)
+    return ata_inv @ s @ ata_inv
+
+
+def regress(
+    runs: Sequence[_Run],
+    params: VMMParams,
+    terms: Sequence[str],
+    *,
+    delta_0: float = 0.0,
+    current: Sequence[float] = (0.0, 0.0),
+    stderr: bool = True,
+) -> RegressionResult:
+    """Inverse-dynamics least squares of ``terms`` on ``runs`` (module docstring).
+
+    Parameters
+    ----------
+    runs : sequence of _Run
+        From :func:`prepare_runs`.
+    params : VMMParams
+        Particulars and added masses (coefficients ignored).
+    terms : sequence of str
+        Term names (:data:`shipgym.models.vmm.TERM_SETS` or any valid names).
+    delta_0 : float
+        Rudder offset [rad].
+    current : sequence of float
+        Constant current ``(V_x, V_y)`` [m/s] in the earth frame.
+    stderr : bool
+        Compute the Newey-West standard errors (the costly part).
+
+    Returns
+    -------
+    RegressionResult
+    """
+    table = term_matrix(list(terms))
+    rows_f, rows_y, segments, lags = [], [], [], []
+    start = 0
+    for run in runs:
+        f, big_u, ur, vr = _factors(run, params, delta_0, current)
+        forces = _forces(run, params, current, ur, vr)
+        q = 0.5 * params.rho * params.length**2 * big_u**2
+        prime = forces / np.column_stack((q, q, q * params.length))
+        rows_f.append(f)
+        rows_y.append(prime)
+        n = f.shape[0]
+        segments.append(slice(start, start + n))
+        start += n
+        h = float(np.median(np.diff(run.t)))
+        lags.append(int(round(FILTER_LENGTHS * params.length / np.median(big_u) / h)))
+    f = np.concatenate(rows_f)
+    y = np.concatenate(rows_y)
+    mono = _monomials(table, f)
+    coefficients: dict[str, float] = {}
+    se: dict[str, float] = {}
+    collinear: dict[str, list[str]] = {}
+    condition: dict[str, float] = {}
+    r2: dict[str, float] = {}
+    names = list(terms)
+    for eq, label in enumerate("XYN"):
+        idx = [k for k in range(len(names)) if table[k, 0] == eq]
+        if not idx:
+            continue
+        a = mono[:, idx]
+        norms = np.linalg.norm(a, axis=0)
+        norms[norms == 0] = 1.0
+        an = a / norms
+        _, rr, piv = qr(an, mode="economic", pivoting=True)
+        diag = np.abs(np.diag(rr))
+        keep_n = int(np.sum(diag > COLLINEAR_RCOND * diag[0])) if diag.size else 0
+        kept = sorted(piv[:keep_n].tolist())
+        dropped = piv[keep_n:].tolist()
+        ak = an[:, kept]
+        sol, *_ = np.linalg.lstsq(ak, y[:, eq], rcond=None)
+        e = y[:, eq] - ak @ sol
+        for j in dropped:  # the kept terms that explain the dropped column
+            c, *_ = np.linalg.lstsq(ak, an[:, j], rcond=None)
+            big = np.argsort(-np.abs(c))[:3]
+            collinear[names[idx[j]]] = [names[idx[kept[b]]] for b in big if abs(c[b]) > 0.05]
+            coefficients[names[idx[j]]] = 0.0
+            se[names[idx[j]]] = math.nan
+        sv = np.linalg.svd(ak, compute_uv=False)
+        condition[label] = float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else math.inf
+        ss = float(np.sum((y[:, eq] - y[:, eq].mean()) ** 2))
+        r2[label] = 1.0 - float(e @ e) / ss if ss > 0 else math.nan
+        if stderr:
+            cov = _newey_west(ak, e, segments, max(1, int(np.median(lags))))
+            sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        else:
+            sd = np.full(len(kept), math.nan)
+        for b, j in enumerate(kept):
+            coefficients[names[idx[j]]] = float(sol[b] / norms[j])
+            se[names[idx[j]]] = float(sd[b] / norms[j])
+    coefficients = {k: coefficients[k] for k in names}
+    se = {k: se[k] for k in names}
+    return RegressionResult(coefficients, se, collinear, condition, r2, int(f.shape[0]))
+
+
+# --------------------------------------------------------------------------------------------
+# replay (simulation of runs from the measured states)
+
+
+@row_kernel
+def _vmm_deriv(model_id, x, u, p, c, out):  # pragma: no cover - jit
+    vmm_row(x, u, p, c, out)
+
+
+@kernel
+def _replay_kernel(t, starts, ends, x0, inputs, p, c, out):  # pragma: no cover - jit
+    """Simulate windows ``[starts[w], ends[w])`` of concatenated samples, each from
+    ``x0[w]``, with the inputs held over each step (direct rudder)."""
+    x = np.empty((1, 7))
+    u = np.empty((1, 4))
+    cc = np.empty((1, 2))
+    cc[0, 0] = c[0]
+    cc[0, 1] = c[1]
+    work = np.empty((5, 7))
+    for w in range(starts.shape[0]):
+        i0 = starts[w]
+        for j in range(6):
+            x[0, j] = x0[w, j]
+        x[0, 6] = 0.0
+        for j in range(6):
+            out[i0, j] = x[0, j]
+        for k in range(i0, ends[w] - 1):
+            for j in range(4):
+                u[0, j] = inputs[k, j]
+            h = t[k + 1] - t[k]
+            rk4_stages(_vmm_deriv, 0, x, u, p, cc, h, 0, work[0], work[1], work[2], work[3],
+                       work[4])  # fmt: skip
+            for j in range(6):
+                out[k + 1, j] = x[0, j]
+
+
+@dataclass
+class _Replay:
+    """Runs thinned to the replay step and cut into windows, concatenated for the kernel."""
+
+    t: np.ndarray
+    inputs: np.ndarray
+    measured: np.ndarray  # (n, 6) measured values at the thinned samples
+    starts: np.ndarray
+    ends: np.ndarray
+    x0: np.ndarray
+    run_of: np.ndarray  # run index of every sample
+    first: np.ndarray  # True at window starts (not scored)
+
+    def run_mask(self, runs: Sequence[int]) -> np.ndarray:
+        """Scored samples of the runs ``runs``."""
+        return np.isin(self.run_of, list(runs)) & ~self.first
+
+
+def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | None) -> _Replay:
+    parts_t, parts_u, parts_m, run_of = [], [], [], []
+    starts, ends, x0 = [], [], []
+    n0 = 0
+    for i, run in enumerate(runs):
+        h = float(np.median(np.diff(run.t)))
+        speed = float(np.median(np.hypot(run.states[:, 3], run.states[:, 4])))
+        stride = max(1, int(STEP_LENGTHS * params.length / max(speed, 1e-3) / h))
+        sel = np.arange(0, run.t.size, stride)
+        t = run.t[sel]
+        parts_t.append(t)
+        parts_u.append(np.column_stack((run.delta[sel], run.thrust[sel], run.wind[sel])))
+        parts_m.append(run.measured[sel])
+        run_of.append(np.full(sel.size, i))
+        for s in window_starts(t, window_s):
+            starts.append(n0 + int(s))
+            x0.append(run.states[sel[s]])
+        ends.extend(starts[len(ends) + 1 :])
+        ends.append(n0 + sel.size)
+        n0 += sel.size
+    # windows of one run end where the next starts; the last at the run's end
+    ends_arr = np.array(ends, dtype=np.int64)
+    starts_arr = np.array(starts, dtype=np.int64)
+    first = np.zeros(n0, dtype=bool)
+    first[starts_arr] = True
+    return _Replay(
+        np.concatenate(parts_t), np.concatenate(parts_u), np.concatenate(parts_m), starts_arr,
+        ends_arr, np.array(x0), np.concatenate(run_of), first,
+    )  # fmt: skip
+
+
+def replay(rp: _Replay, params: VMMParams, current: Sequence[float] = (0.0, 0.0)) -> np.ndarray:
+    """``(n, 6)`` simulated ``x, y, psi, u, v, r`` of the replay windows (direct rudder)."""
+    out = np.empty((rp.t.size, 7))
+    p = pack_vmm(replace(params, direct_rudder=True))
+    _replay_kernel(rp.t, rp.starts, rp.ends, rp.x0, rp.inputs, p,
+                   np.asarray(current, dtype=np.float64), out)  # fmt: skip
+    return out[:, :6]
+
+
+def _channel_errors(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
+    """``(4, n)`` errors of ``psi`` (wrapped), ``r``, ``u``, ``v``."""
+    return np.vstack((
+        wrap(sim[:, 2] - meas[:, 2]), sim[:, 5] - meas[:, 5], sim[:, 3] - meas[:, 3],
+        sim[:, 4] - meas[:, 4],
+    ))  # fmt: skip
+
+
+# --------------------------------------------------------------------------------------------
+# the fitted model
+
+
+@dataclass
+class VMMFit:
+    """A fitted VMM.
+
+    Attributes
+    ----------
+    params : VMMParams
+        The model (coefficients, rudder offset).
+    current : tuple of float
+        The current ``(V_x, V_y)`` [m/s] of the records.
+    effects : tuple of str
+        Effects in the model.
+    regression : RegressionResult
+        The inverse-dynamics regression the model started from.
+    refined : bool
+        Whether the output-error refinement ran.
+    stderr : dict
+        Standard errors of the coefficients (the regression's Newey-West values).
+    """
+
+    params: VMMParams
+    current: tuple[float, float]
+    effects: tuple[str, ...]
+    regression: RegressionResult
+    refined: bool = False
+    stderr: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def values(self) -> dict[str, float]:
+        """Every fitted number: coefficients, and the effects' own parameters."""
+        out = dict(self.params.coefficients)
+        if "rudder_offset" in self.effects:
+            out["delta_0"] = self.params.rudder_offset
+        if "current" in self.effects:
+            out["V_x"], out["V_y"] = self.current
+        return out
+
+
+def _terms_of(term_set: str | Sequence[str], effects: Sequence[str]) -> list[str]:
+    base = list(TERM_SETS[term_set]) if isinstance(term_set, str) else list(term_set)
+    for e in effects:
+        base += [t for t in _EFFECT_TERMS.get(e, ()) if t not in base]
+    return base
+
+
+def _offsets_fit(
+    runs: Sequence[_Run], params: VMMParams, terms: list[str], effects: Sequence[str]
+) -> tuple[float, tuple[float, float]]:
+    """Rudder offset and current that minimise the normalised regression residual."""
+    free = [k for k in ("rudder_offset", "current") if k in effects]
+    if not free:
+        return 0.0, (0.0, 0.0)
+
+    def unpack(th: np.ndarray) -> tuple[float, tuple[float, float]]:
+        d0 = float(th[0]) if "rudder_offset" in free else 0.0
+        c = (float(th[-2]), float(th[-1])) if "current" in free else (0.0, 0.0)
+        return d0, c
+
+    def cost(th: np.ndarray) -> float:
+        d0, c = unpack(th)
+        res = regress(runs, params, terms, delta_0=d0, current=c, stderr=False)
+        return sum(1.0 - v for v in res.r2.values())
+
+    from scipy.optimize import minimize
+
+    x0 = np.zeros(("rudder_offset" in free) + 2 * ("current" in free))
+    lo = [VMM_EFFECTS[k].bounds[p][0] for k in free for p in VMM_EFFECTS[k].parameters]
+    hi = [VMM_EFFECTS[k].bounds[p][1] for k in free for p in VMM_EFFECTS[k].parameters]
+    sol = minimize(cost, x0, method="Powell", bounds=list(zip(lo, hi, strict=True)),
+                   options={"xtol": 1e-4, "ftol": 1e-6})  # fmt: skip
+    return unpack(sol.x)
+
+
+def fit_vmm(
+    runs: Sequence[_Run],
+    template: VMMParams,
+    term_set: str | Sequence[str],
+    effects: Sequence[str] = (),
+    *,
+    rp: _Replay | None = None,
+    fit_runs: Sequence[int] | None = None,
+    refine_fit: bool = True,
+    start: VMMFit | None = None,
+) -> VMMFit:
+    """Regression, then (with ``rp``) output-error refinement on the runs ``fit_runs``."""
+    terms = _terms_of(term_set, effects)
+    chosen = [runs[i] for i in (fit_runs if fit_runs is not None else range(len(runs)))]
+    d0, cur = _offsets_fit(chosen, template, terms, effects)
+    reg = regress(chosen, template, terms, delta_0=d0, current=cur)
+    params = template.with_coefficients(reg.coefficients, rudder_offset=d0)
+    fit = VMMFit(params, cur, tuple(effects), reg, False, dict(reg.stderr))
+    if refine_fit and rp is not None:
+        fit = refine(fit, rp, fit_runs if fit_runs is not None else range(len(runs)))
+    return fit
+
+
+def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 30) -> VMMFit:
+    """Output-error refinement of ``fit`` on the runs ``fit_runs`` (module docstring): weighted
+    least squares of the simulated ``psi, r, u, v`` from the regression result; the
+    coefficients left out as collinear stay out. Keeps the start when the simulation of the
+    start diverges and the refinement cannot make it finite."""
+    mask = rp.run_mask(fit_runs)
+    meas = rp.measured[mask]
+    free = [k for k, v in fit.params.coefficients.items() if k not in fit.regression.collinear]
+    extra = (["delta_0"] if "rudder_offset" in fit.effects else []) + (
+        ["V_x", "V_y"] if "current" in fit.effects else []
+    )
+    x0 = np.array([fit.params.coefficients[k] for k in free]
+                  + [fit.values[k] for k in extra])  # fmt: skip
+    scale = np.array(
+        [max(abs(fit.params.coefficients[k]), fit.stderr.get(k, 0.0) or 0.0, 1e-6)
+         for k in free] + [0.01] * len(extra)
+    )  # fmt: skip
+    sigma = np.array([meas[:, 2].std(), meas[:, 5].std(), meas[:, 3].std(), meas[:, 4].std()])
+    sigma = np.maximum(sigma, 1e-6)
+
+    def build(th: np.ndarray) -> tuple[VMMParams, tuple[float, float]]:
+        coeffs = dict(fit.params.coefficients)
+        coeffs.update(zip(free, th[: len(free)], strict=True))
+        vals = dict(zip(extra, th[len(free) :], strict=True))
+        params = fit.params.with_coefficients(coeffs, rudder_offset=vals.get("delta_0", 0.0))
+        return params, (vals.get("V_x", 0.0), vals.get("V_y", 0.0))
+
+    def resid(th: np.ndarray) -> np.ndarray:
+        params, cur = build(th)
+        sim = replay(rp, params, cur)[mask]
+        e = _channel_errors(sim, meas) / sigma[:, None]
+        e = np.where(np.isfinite(e), e, 1e3)
+        return np.clip(e, -1e3, 1e3).ravel()
+
+    r0 = resid(x0)  # reweight: each channel by its RMS error of the start
+    sigma = sigma * np.maximum(np.sqrt(np.mean(r0.reshape(4, -1) ** 2, axis=1)), 1e-3)
+    r0 = resid(x0)
+    sol = least_squares(resid, x0, x_scale=scale, method="trf", max_nfev=max_nfev,
+                        xtol=1e-6, ftol=1e-6)  # fmt: skip
+    if not float(sol.cost) < 0.5 * float(r0 @ r0):
+        return fit
+    params, cur = build(sol.x)
+    return replace(fit, params=params, current=cur, refined=True)
+
+
+# --------------------------------------------------------------------------------------------
+# the family
+
+
+@dataclass
+class _Context:
+    runs: list[_Run]
+    rp: _Replay
+    train: list[int]
+    held: list[int]
+    template: VMMParams
+
+
+def _rms(sim: np.ndarray, meas: np.ndarray) -> dict[str, float]:
+    """RMS errors of a replay: ``psi_rms_deg``, ``r_rms_deg_s``, ``u_rms_m_s``, ``v_rms_m_s``
+    and the position error ``xy_rms_m``."""
+    e = _channel_errors(sim, meas) ** 2
+    d2 = (sim[:, 0] - meas[:, 0]) ** 2 + (sim[:, 1] - meas[:, 1]) ** 2
+    rms = np.sqrt(np.mean(e, axis=1))
+    return {
+        "psi_rms_deg": math.degrees(float(rms[0])),
+        "r_rms_deg_s": math.degrees(float(rms[1])),
+        "u_rms_m_s": float(rms[2]),
+        "v_rms_m_s": float(rms[3]),
+        "xy_rms_m": float(np.sqrt(np.mean(d2))),
+    }
+
+
+class VMMFamily(ModelFamily):
+    """Seed 003's VMM of one term set as an identification family (module docstring).
+
+    Parameters
+    ----------
+    term_set : str
+        A key of :data:`shipgym.models.vmm.TERM_SETS`.
+    particulars : VMMParams, optional
+        The ship (mass, inertia, ``x_G``, added masses); by default :func:`vessel_params` of
+        the first record.
+    refine : bool
+        Run the output-error refinement (the loop's candidates are scored after it too).
+    """
+
+    multi_run = True
+    catalogue = VMM_EFFECTS
+    min_relative_drop = VMM_MIN_RELATIVE_DROP
+    default_window_s = None
+
+    def __init__(
+        self, term_set: str = "martin", particulars: VMMParams | None = None, refine: bool = True
+    ) -> None:
+        if term_set not in TERM_SETS:
+            raise ValueError(f"unknown term set {term_set!r}; expected one of {tuple(TERM_SETS)}")
+        self.term_set = term_set
+        self.name = f"vmm:{term_set}"
+        self.particulars = particulars
+        self.refine = refine
+
+    def prepare(self, record: Any, holdout: float, window_s: float | None) -> _Context:
+        records = list(record) if isinstance(record, list | tuple) else [record]
+        template = self.particulars or vessel_params(records[0])
+        if any(r.thrust is None for r in records) and template.thrust_from == "thrust":
+            template = replace(template, thrust_from="rps")
+        if template.thrust_from == "rps":
+            records = [replace(r, thrust=None) if r.thrust is not None else r for r in records]
+        if len(records) == 1:  # one run: split in time
+            rec = records[0]
+            cut = _cut(rec)
+            t_split = float(cut.time[0] + (1.0 - holdout) * (cut.time[-1] - cut.time[0]))
+            records = [cut.slice(float(cut.time[0]), t_split),
+                       cut.slice(t_split, float(cut.time[-1]))]  # fmt: skip
+            train, held = [0], [1]
+        else:
+            k = max(2, round(1.0 / holdout))
+            held = [i for i in range(len(records)) if i % k == k - 1] or [len(records) - 1]
+            train = [i for i in range(len(records)) if i not in held]
+        runs = prepare_runs(records, template)
+        rp = _build_replay(runs, template, window_s)
+        return _Context(runs, rp, train, held, template)
+
+    def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
+        sim = replay(ctx.rp, fit.params, fit.current)
+        mask = ctx.rp.run_mask(ctx.held)
+        n = int(mask.sum())
+        if not np.all(np.isfinite(sim[mask])):
+            return Candidate(fit.effects, fit, math.inf, math.inf)
+        e = _channel_errors(sim[mask], ctx.rp.measured[mask])
+        rss = {ch: float(row @ row) for ch, row in zip(_CHANNELS, e, strict=True)}
+        rms = {k: math.sqrt(v / n) for k, v in rss.items()}
+        err = math.exp(float(np.mean([math.log(max(v, 1e-300)) for v in rms.values()])))
+        k = len(fit.values) - len(fit.regression.collinear)
+        return Candidate(fit.effects, fit, bic(rss, n, k), err, rms)
+
+    def _fit(self, ctx: _Context, effects: Sequence[str], runs: Sequence[int]) -> VMMFit:
+        return fit_vmm(ctx.runs, ctx.template, self.term_set, effects, rp=ctx.rp,
+                       fit_runs=runs, refine_fit=self.refine)  # fmt: skip
+
+    def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
+        fit = self._fit(ctx, (), ctx.train)
+        if fit.regression.collinear:
+            say(f"  collinear terms left out: {', '.join(fit.regression.collinear)}")
+        return self._score(ctx, fit)
+
+    def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
+        if name == "wind" and not all(r.has_wind for r in ctx.runs):
+            raise ValueError("the records have no wind channels")
+        return self._score(ctx, self._fit(ctx, (*current.effects, name), ctx.train))
+
+    def effect_parameters(self, fitted: VMMFit, name: str) -> dict[str, float]:
+        vals = fitted.values
+        out = {k: vals.get(k, 0.0) for k in VMM_EFFECTS[name].parameters}
+        if name == "rudder_offset":
+            out["delta_0_deg"] = math.degrees(out["delta_0"])
+        elif name == "current":
+            out["speed"] = math.hypot(out["V_x"], out["V_y"])
+        return out
+
+    def finish(
+        self, ctx: _Context, base: Candidate, final: Candidate, say: Callable[[str], None]
+    ) -> dict[str, Any]:
+        everything = list(range(len(ctx.runs)))
+        say("fits of the base and final models on every run")
+        base_full = self._fit(ctx, (), everything)
+        final_full = self._fit(ctx, final.effects, everything) if final.effects else base_full
+        sims = {
+            "before": replay(ctx.rp, base_full.params, base_full.current),
+            "after": replay(ctx.rp, final_full.params, final_full.current),
+        }
+        every = ctx.rp.run_mask(everything)
+        held_mask = ctx.rp.run_mask(ctx.held)
+        heldout = {
+            "runs": [ctx.runs[i].name for i in ctx.held],
+            "error_before": _rms(replay(ctx.rp, base.fitted.params, base.fitted.current)[held_mask],
+                                 ctx.rp.measured[held_mask]),
+            "error_after": _rms(
+                replay(ctx.rp, final.fitted.params, final.fitted.current)[held_mask],
+                ctx.rp.measured[held_mask],
+            ),
+        }  # fmt: skip
+        per_run = {}
+        for i, run in enumerate(ctx.runs):
+            m = ctx.rp.run_mask([i])
+            per_run[run.name] = _rms(sims["after"][m], ctx.rp.measured[m])
+        traces: dict[str, Any] = {"time": ctx.rp.t, "run": ctx.rp.run_of,
+                                  "window_starts": ctx.rp.starts}  # fmt: skip
+        for ch in ("psi", "r", "u", "v", "x", "y"):
+            col = _STATE_COL[ch]
+            traces[ch] = {"measured": ctx.rp.measured[:, col],
+                          **{k: s[:, col] for k, s in sims.items()}}  # fmt: skip
+        reg = final_full.regression
+        return {
+            "base": base_full,
+            "final": final_full,
+            "diagnostics": {
+                "final": {
+                    "stderr": final_full.stderr,
+                    "collinear": reg.collinear,
+                    "condition": reg.condition,
+                    "r2": reg.r2,
+                    "refined": final_full.refined,
+                    "per_run": per_run,
+                },
+                "base": {"stderr": base_full.stderr, "collinear": base_full.regression.collinear},
+            },
+            "parameters_before": base_full.values,
+            "parameters_after": final_full.values,
+            "error_before": _rms(sims["before"][every], ctx.rp.measured[every]),
+            "error_after": _rms(sims["after"][every], ctx.rp.measured[every]),
+            "heldout": heldout,
+            "traces": traces,
+            "effect_parameters": {
+                e: self.effect_parameters(final_full, e) for e in final_full.effects
+            },
+        }
+
+
+for _name in TERM_SETS:
+    register(VMMFamily(_name), f"vmm:{_name}")
+del _name
