@@ -10,7 +10,8 @@ environments, the manoeuvres and identification, integrates through these functi
 Both run ship by ship through ``rk4_stages``, whose four stages use small work vectors that
 stay in the CPU cache; the environments' kernels call ``rk4_row`` (the same stages over the
 environment models' derivative ``row_rhs``) inside their own row loops, so they do not compile
-the 3-DOF model-test models (MMG, VMM), which no environment uses (it would add 40 % to their compile time).
+the 3-DOF model-test models (MMG, VMM), which no environment uses (it would add 40 % to their
+compile time).
 """
 
 from __future__ import annotations

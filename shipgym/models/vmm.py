@@ -302,13 +302,8 @@ class VMMParams:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready description (:meth:`from_dict` reads it back)."""
-        out: dict[str, Any] = {
-            k: getattr(self, k)
-            for k in ("length", "breadth", "draught", "mass", "x_g", "yaw_inertia",
-                      "approach_speed", "propeller_diameter", "rho", "rudder_offset",
-                      "max_rudder", "rudder_rate", "rudder_time_constant", "include_c_a",
-                      "direct_rudder", "thrust_from", "name")  # fmt: skip
-        }
+        keys = (*_REQUIRED_KEYS, *_OPTIONAL_KEYS)
+        out: dict[str, Any] = {k: getattr(self, k) for k in keys}
         out["coefficients"] = dict(self.coefficients)
         out["added"] = dict(self.added)
         return out
@@ -365,8 +360,10 @@ class VMMParams:
 _ADDED = ("X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot")
 _REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
                   "yaw_inertia", "added", "approach_speed")  # fmt: skip
-_OPTIONAL_KEYS = ("propeller_diameter", "rho", "rudder_offset", "max_rudder", "rudder_rate",
-                  "rudder_time_constant", "include_c_a", "direct_rudder", "thrust_from", "name")  # fmt: skip
+_OPTIONAL_KEYS = (
+    "propeller_diameter", "rho", "rudder_offset", "max_rudder", "rudder_rate",
+    "rudder_time_constant", "include_c_a", "direct_rudder", "thrust_from", "name",
+)  # fmt: skip
 
 # packed layout
 P_MU = 0  # m - X_udot

@@ -148,15 +148,18 @@ def identify(
     ----------
     record : Record or sequence of Record
         A manoeuvre record, or several runs of one ship for a family that cross-validates
-        across runs (``vmm:<term set>``: fitted on some runs, scored on the others). The Nomoto family needs ``time``, ``delta``, ``psi``, ``r`` (``x``,
-        ``y`` and a speed enable its ``current`` effect); ``rvg3dof`` needs ``rpm``, the
-        azimuth order, positions and speeds, as in the Gunnerus sea trials.
+        across runs (``vmm:<term set>``: fitted on some runs, scored on the others). The
+        Nomoto family needs ``time``, ``delta``, ``psi``, ``r`` (``x``, ``y`` and a speed
+        enable its ``current`` effect); ``rvg3dof`` needs ``rpm``, the azimuth order,
+        positions and speeds, as in the Gunnerus sea trials; ``vmm:...`` positions, body
+        velocities and thrust or rpm.
     model : str or ModelFamily
         A registered model name (``"nomoto1"``, ``"nomoto2"``, ``"norrbin"``, ``"bech"``,
-        ``"rvg3dof"``) or a family object.
+        ``"rvg3dof"``, ``"vmm:linear"``, ``"vmm:abkowitz"``, ``"vmm:martin"``,
+        ``"vmm:martin_simple"``, ``"vmm:norrbin3"``) or a family object.
     holdout : float
         Fraction of the record (its end) kept out of the fits and used for scoring, in
-        ``[0.1, 0.6]``.
+        ``[0.1, 0.6]``; with several runs, every ``round(1 / holdout)``-th run is held out.
     max_effects : int
         Largest number of effects to add (>= 0).
     window_s : float, "auto" or None
@@ -180,7 +183,9 @@ def identify(
     runs = list(record) if isinstance(record, list | tuple) else [record]
     for rec in runs:
         if not isinstance(rec, Record):
-            raise ValueError(f"record must be a shipgym.sysid.data.Record, got {type(rec).__name__}")
+            raise ValueError(
+                f"record must be a shipgym.sysid.data.Record, got {type(rec).__name__}"
+            )
     if not runs:
         raise ValueError("identify needs at least one record")
     if len(runs) > 1 and not family.multi_run:
@@ -199,9 +204,7 @@ def identify(
         isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0
     ):
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
-    window = family.resolve_window(
-        window_s, max(float(r.time[-1] - r.time[0]) for r in runs)
-    )
+    window = family.resolve_window(window_s, max(float(r.time[-1] - r.time[0]) for r in runs))
     say = progress or (lambda _msg: None)
     ctx = family.prepare(runs if family.multi_run else runs[0], float(holdout), window)
 

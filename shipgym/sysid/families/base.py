@@ -149,9 +149,7 @@ class ModelFamily(ABC):
         return float(window_s)
 
     @abstractmethod
-    def prepare(
-        self, record: Record | list[Record], holdout: float, window_s: float | None
-    ) -> Any:
+    def prepare(self, record: Record | list[Record], holdout: float, window_s: float | None) -> Any:
         """Check ``record`` (``ValueError`` naming what is missing) and split it; returns the
         context every other method receives. A :attr:`multi_run` family gets a list of runs."""
 

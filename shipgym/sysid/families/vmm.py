@@ -32,7 +32,7 @@ accelerations of free-running manoeuvres are too small and too correlated with t
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -270,7 +270,7 @@ def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
         else:
             raise ValueError(f"{name}: 3-DOF identification needs a thrust or rpm channel")
         speed = float(np.median(np.hypot(rec.u, rec.v)))
-        w = int(round(FILTER_LENGTHS * params.length / max(speed, 1e-3) / h)) // 2 * 2 + 1
+        w = round(FILTER_LENGTHS * params.length / max(speed, 1e-3) / h) // 2 * 2 + 1
         w = max(w, 5)
         if rec.n < 3 * w:
             raise ValueError(f"{name}: too short ({rec.n} samples) for a {w}-sample filter")
@@ -279,13 +279,10 @@ def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
         accel = savgol_filter(meas[:, 3:6], w, 2, deriv=1, delta=h, axis=0)
         has_wind = rec.wind_speed is not None and rec.wind_angle is not None
         wind = (
-            np.column_stack((rec.wind_speed, rec.wind_angle))
-            if has_wind
-            else np.zeros((rec.n, 2))
+            np.column_stack((rec.wind_speed, rec.wind_angle)) if has_wind else np.zeros((rec.n, 2))
         )
         runs.append(
-            _Run(name, rec.time, states, accel, rec.delta, np.asarray(thrust), wind, has_wind,
-                 meas)  # fmt: skip
+            _Run(name, rec.time, states, accel, rec.delta, np.asarray(thrust), wind, has_wind, meas)
         )
     return runs
 
@@ -443,7 +440,7 @@ def regress(
         segments.append(slice(start, start + n))
         start += n
         h = float(np.median(np.diff(run.t)))
-        lags.append(int(round(FILTER_LENGTHS * params.length / np.median(big_u) / h)))
+        lags.append(round(FILTER_LENGTHS * params.length / np.median(big_u) / h))
     f = np.concatenate(rows_f)
     y = np.concatenate(rows_y)
     mono = _monomials(table, f)
