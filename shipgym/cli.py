@@ -382,18 +382,38 @@ def _run_simulate(args: argparse.Namespace) -> int:
             raise ValueError(f"{flag} applies to the {only} only, not to {kind!r}")
     if args.plot and Path(args.plot).suffix.lower() != ".png":
         raise ValueError(f"--plot must name a .png file, got {args.plot!r}")
-    if args.params is not None and args.model != "rvg3dof":
-        raise ValueError(f"--params selects an rvg3dof parameter set, not one of {args.model!r}")
     from shipgym.models import make_model
+    from shipgym.models.rvg import RVG_PARAMETER_SETS
 
-    args.ship = make_model("rvg3dof", args.params) if args.model == "rvg3dof" else args.model
+    if args.model == "vmm":
+        if args.params is None:
+            raise ValueError(
+                "--model vmm needs --params FIT.json: a fitted model (shipgym identify "
+                "--model vmm:<term set> --json FIT.json)"
+            )
+        args.ship = make_model("vmm", args.params)
+    elif args.model == "rvg3dof":
+        if args.params is not None and args.params not in RVG_PARAMETER_SETS:
+            raise ValueError(
+                f"--params for rvg3dof must be one of {RVG_PARAMETER_SETS}, got {args.params!r}"
+            )
+        args.ship = make_model("rvg3dof", args.params)
+    elif args.params is not None:
+        raise ValueError(
+            f"--params selects an rvg3dof parameter set or a fitted vmm, not one of {args.model!r}"
+        )
+    else:
+        args.ship = args.model
     params = f" --params {args.params}" if args.params else ""
     print(f"shipgym simulate {kind} --model {args.model}{params} ...", file=sys.stderr, flush=True)
     payload, draw, rows = _SIMULATE[kind](args)
     if args.model == "rvg3dof":
         payload["params"] = args.ship.params.name
     if kind in ("zigzag", "turning"):
-        lu = PARTICULARS[args.model].length_over_speed
+        if args.model == "vmm":
+            lu = args.ship.params.length / args.ship.params.approach_speed
+        else:
+            lu = PARTICULARS[args.model].length_over_speed
         title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
         print(format_imo_table(rows, title=title))
         payload["imo"] = [row.to_dict() for row in rows]
@@ -430,8 +450,9 @@ def _build_simulate(sub: Any) -> None:
     p.add_argument(
         "--params",
         default=None,
-        choices=RVG_PARAMETER_SETS,
-        help="rvg3dof parameter set: seed001 (default) or sea_trials (identified from the trials)",
+        metavar="SET|FIT.json",
+        help=f"rvg3dof parameter set ({' or '.join(RVG_PARAMETER_SETS)}; default seed001); for "
+        "vmm the model file of a fit (shipgym identify --model vmm:<term set> --json FIT.json)",
     )
     p.add_argument(
         "--angle-deg",
@@ -963,7 +984,11 @@ def _identify_summary(result: Any, source: str) -> str:
 
     lines = [f"shipgym identify {source}", f"model: {result.model}"]
     starts = result.traces.get("window_starts", [0]) if result.traces else [0]
-    if result.window_s is None:
+    if "run" in (result.traces or {}):
+        how = "each run simulated from its measured initial state"
+        if result.window_s is not None:
+            how += f", in windows of {result.window_s:g} s"
+    elif result.window_s is None:
         how = "one free run from the estimated initial state"
     else:
         how = (
@@ -997,23 +1022,42 @@ def _identify_summary(result: Any, source: str) -> str:
     else:
         lines.append("effects added: none (no candidate was significant on the held-out part)")
     p_before, p_after = result.parameters_before, result.parameters_after
+    stderr = ((result.diagnostics or {}).get("final") or {}).get("stderr") or {}
     lines.append("parameters:")
-    rows = [("", "before", "after")]
+    rows = [("", "before", "after", "std. error")]
     for name in [*p_before, *(k for k in p_after if k not in p_before)]:
+        se = stderr.get(name)
         rows.append(
             (
                 _param_label(name),
                 _format_value(name, p_before[name]) if name in p_before else "-",
                 _format_value(name, p_after[name]) if name in p_after else "-",
+                _format_value(name, se, 2) if isinstance(se, float) and math.isfinite(se) else "-",
             )
         )
     lines.extend(_table(rows))
     held = result.heldout or {}
     if held.get("error_before") is not None and held.get("error_after") is not None:
-        lines.append(
-            f"held-out part from {held.get('from_s', math.nan):.1f} s (models fitted on the "
-            f"rest): {format_errors(held['error_before'], held['error_after'])}"
+        where = (
+            f"runs {', '.join(held['runs'])}"
+            if "runs" in held
+            else f"part from {held.get('from_s', math.nan):.1f} s"
         )
+        lines.append(
+            f"held-out {where} (models fitted on the rest): "
+            f"{format_errors(held['error_before'], held['error_after'])}"
+        )
+    final = (result.diagnostics or {}).get("final", {})
+    if final.get("collinear"):
+        lines.append("terms left out as collinear (pivoted QR), with the terms they follow:")
+        lines.extend(f"  {k}: {', '.join(v)}" for k, v in final["collinear"].items())
+    if final.get("per_run"):
+        lines.append("error of the final model per run:")
+        rows = [("run", "psi [deg]", "r [deg/s]", "u [m/s]", "v [m/s]")]
+        keys = ("psi_rms_deg", "r_rms_deg_s", "u_rms_m_s", "v_rms_m_s")
+        for run, e in final["per_run"].items():
+            rows.append((run, *(f"{e[k]:.3g}" for k in keys)))
+        lines.extend(_table(rows))
     for key, errors in held.items():  # further reference errors, e.g. of published parameters
         if key.startswith("error_") and key not in ("error_before", "error_after"):
             if isinstance(errors, dict):
@@ -1091,14 +1135,22 @@ def _run_identify(args: argparse.Namespace) -> int:
         print(f"[{time.perf_counter() - t0:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     say = (lambda _msg: None) if args.quiet else progress
-    say(f"loading {args.path} ...")
-    record, fmt = _load_for_identify(args.path, args.format, note)
-    chans = " ".join(k for k in record.channels() if k != "time")
-    source = (
-        f"{args.path} ({fmt}, {record.n} samples, {record.duration:g} s at dt "
-        f"{record.dt:g} s; channels {chans})"
-    )
-    say(f"loaded {source}")
+    records, sources = [], []
+    for path_text in args.path:
+        say(f"loading {path_text} ...")
+        record, fmt = _load_for_identify(path_text, args.format, note)
+        chans = " ".join(k for k in record.channels() if k != "time")
+        sources.append(
+            f"{path_text} ({fmt}, {record.n} samples, {record.duration:g} s at dt "
+            f"{record.dt:g} s; channels {chans})"
+        )
+        say(f"loaded {sources[-1]}")
+        records.append(record)
+    source = sources[0] if len(sources) == 1 else f"{len(sources)} runs:\n  " + "\n  ".join(sources)
+    inputs = {Path(p).resolve() for p in args.path}
+    for out_path in (json_path, plot_path):
+        if out_path is not None and out_path.resolve() in inputs:
+            raise ValueError(f"output {str(out_path)!r} is one of the input records; refusing")
     window = {None: "none", "auto": "auto"}.get(args.window) or f"{args.window:g} s"
     say(
         f"identifying base {args.model} (holdout {args.holdout:g}, at most {args.max_effects} "
@@ -1108,7 +1160,7 @@ def _run_identify(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", SysidWarning)
         try:
             result = identify(
-                record,
+                records if len(records) > 1 else records[0],
                 args.model,
                 holdout=args.holdout,
                 max_effects=args.max_effects,
@@ -1116,7 +1168,9 @@ def _run_identify(args: argparse.Namespace) -> int:
                 progress=None if args.quiet else progress,
             )
         except ValueError as exc:
-            raise ValueError(f"cannot identify {args.model} from {args.path}: {exc}") from exc
+            raise ValueError(
+                f"cannot identify {args.model} from {', '.join(args.path)}: {exc}"
+            ) from exc
     for msg in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught):
         note(msg)
     say(f"done in {result.runtime_s:.1f} s")
@@ -1157,7 +1211,13 @@ def _build_identify(sub: Any) -> None:
             "evidence, and the parameters. Progress and data-repair notes go to stderr."
         ),
     )
-    p.add_argument("path", metavar="PATH", help="record file")
+    p.add_argument(
+        "path",
+        metavar="PATH",
+        nargs="+",
+        help="record file; several runs of one ship for the 3-DOF models vmm:<term set> "
+        "(fitted on some runs, scored on the others)",
+    )
     p.add_argument(
         "--format",
         default=None,

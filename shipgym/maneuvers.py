@@ -134,6 +134,7 @@ _MODEL_LABELS = {
     "bech": "Bech",
     "rvg3dof": "3-DOF MCSim",
     "kvlcc2": "MMG KVLCC2",
+    "vmm": "VMM",
 }
 
 
@@ -254,21 +255,26 @@ class _Rig:
             )
         self.ship = ship
         self.name = ship.name
-        self.particulars = PARTICULARS[ship.name]
-        self.settings = _RIGS[ship.name]
-        if ship.name == "kvlcc2":  # any length of the KVLCC2: the 7 m model's rig, Froude-scaled
+        if ship.name == "kvlcc2":
             p = ship.params
-            k = math.sqrt(p.length / _KVLCC2.length)
-            self.particulars = ShipParticulars(
-                f"KVLCC2 ({p.length:g} m)" if p.length != _KVLCC2.length else _KVLCC2.vessel,
-                p.length, p.breadth, p.approach_speed,
-            )  # fmt: skip
-            st = self.settings
+            vessel = f"KVLCC2 ({p.length:g} m)" if p.length != _KVLCC2.length else _KVLCC2.vessel
+            self.particulars = ShipParticulars(vessel, p.length, p.breadth, p.approach_speed)
+        elif ship.name == "vmm":
+            p = ship.params
+            self.particulars = ShipParticulars(p.name, p.length, p.breadth, p.approach_speed)
+        else:
+            self.particulars = PARTICULARS[ship.name]
+        if ship.name in ("kvlcc2", "vmm"):
+            # a model-test ship of any length: the 7 m KVLCC2's rig, Froude-scaled
+            k = math.sqrt(self.particulars.length / _KVLCC2.length)
+            st = _RIGS["kvlcc2"]
             self.settings = replace(
                 st, dt=st.dt * k, chunk=st.chunk * k, max_hold=st.max_hold * k,
                 max_duration=st.max_duration * k, ti=st.ti * k,
                 kp=st.kp * k, spiral_yaw_rate=st.spiral_yaw_rate / k,
             )  # fmt: skip
+        else:
+            self.settings = _RIGS[ship.name]
         step = self.settings.dt if dt is None else dt
         if not (isinstance(step, int | float) and math.isfinite(step) and 0 < step <= 1.0):
             raise ValueError(f"dt must be a step in (0, 1] s, got {dt!r}")
@@ -284,10 +290,15 @@ class _Rig:
             self.x0[ship.index("u")] = self._rvg_straight_speed()
             self._iu, self._iv = ship.index("u"), ship.index("v")
             self._ia = (ship.index("alpha1"), ship.index("alpha2"))
-        elif ship.name == "kvlcc2":
+        elif ship.name in ("kvlcc2", "vmm"):
             p = ship.params
             self.max_rudder = float(p.max_rudder)
-            self.shaft = p.self_propulsion_rps(self.particulars.speed)
+            # the propeller at the self-propulsion point (kvlcc2: rps; vmm: the thrust input)
+            self.shaft = (
+                p.self_propulsion_rps(self.particulars.speed)
+                if ship.name == "kvlcc2"
+                else p.approach_thrust()
+            )
             self.x0[ship.index("u")] = self.particulars.speed
             self._iu, self._iv = ship.index("u"), ship.index("v")
             self._idelta = ship.index("delta")
@@ -316,6 +327,8 @@ class _Rig:
         """Model input for an equivalent rudder command ``delta`` [rad] (+ = starboard)."""
         if self.name == "rvg3dof":
             return np.array([self.thrust, self.thrust, -delta, -delta])
+        if self.name == "vmm":
+            return np.array([delta, self.shaft, 0.0, 0.0])
         return np.array([delta, self.shaft])
 
     def rudder(self, states: np.ndarray) -> np.ndarray:
@@ -332,7 +345,7 @@ class _Rig:
 
     def speed(self, states: np.ndarray) -> np.ndarray:
         """Speed through the water [m/s] (``sqrt(u^2 + v^2)`` for the 3-DOF models)."""
-        if self.name in ("rvg3dof", "kvlcc2"):
+        if self.name in ("rvg3dof", "kvlcc2", "vmm"):
             return np.hypot(states[:, self._iu], states[:, self._iv])
         return states[:, self._iU]
 

@@ -333,7 +333,7 @@ class VMMParams:
             data = data["vmm"]
         if not isinstance(data, dict):
             raise ValueError(f"{str(p)!r} holds no VMM description (a JSON object)")
-        return cls.from_dict(data)
+        return cls.from_dict({k: v for k, v in data.items() if k != "current"})
 
     def approach_thrust(self) -> float:
         """Thrust input [N] that holds straight running at the approach speed (from

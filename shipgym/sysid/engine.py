@@ -80,6 +80,9 @@ class IdentificationResult:
         Every candidate's score per round (for inspection).
     runtime_s : float
         Wall time.
+    model_file : dict
+        The fitted model as a document the rest of the package reads (``{"vmm": ...}`` for
+        the 3-DOF models: :meth:`shipgym.models.VMMParams.load`); empty for the others.
     """
 
     model: str
@@ -96,6 +99,7 @@ class IdentificationResult:
     traces: dict[str, Any] = field(default_factory=dict)
     rounds: list[dict[str, Any]] = field(default_factory=list)
     runtime_s: float = 0.0
+    model_file: dict[str, Any] = field(default_factory=dict)
 
     @property
     def effect_names(self) -> list[str]:
@@ -107,10 +111,12 @@ class IdentificationResult:
 
         Keys: ``model``, ``parameters_before``, ``error_before``, ``effects`` (``{name,
         parameters, evidence}`` in order), ``parameters``, ``error_after``, ``window_s``,
-        ``heldout``, ``rounds``, ``runtime_s``. Non-finite numbers become ``null``.
+        ``heldout``, ``rounds``, ``runtime_s`` and the entries of :attr:`model_file`.
+        Non-finite numbers become ``null``.
         """
         return jsonable(
             {
+                **self.model_file,
                 "model": self.model,
                 "parameters_before": self.parameters_before,
                 "error_before": self.error_before,

@@ -45,6 +45,7 @@ METRIC_LABELS: dict[str, tuple[str, str]] = {
     "r_rms_deg_s": ("r RMS", "deg/s"),
     "xy_rms_m": ("xy RMS", "m"),
     "u_rms_m_s": ("u RMS", "m/s"),
+    "v_rms_m_s": ("v RMS", "m/s"),
 }
 """Error key of ``error_before``/``error_after`` -> (label, unit)."""
 
@@ -258,11 +259,14 @@ def plot_identification(
 
     added = f"effects added: {', '.join(effects)}" if effects else "no effect added"
     window_s = getattr(result, "window_s", None)
-    how = (
-        f"windows of {window_s:g} s from the measured state"
-        if windowed
-        else "free run from the estimated initial state"
-    )
+    if "run" in tr:  # several runs, one after the other
+        how = "each run from its measured state" + (
+            f", in windows of {window_s:g} s" if windowed else ""
+        )
+    elif windowed:
+        how = f"windows of {window_s:g} s from the measured state"
+    else:
+        how = "free run from the estimated initial state"
     errors = format_errors(
         getattr(result, "error_before", {}) or {}, getattr(result, "error_after", {}) or {}
     )
