@@ -213,6 +213,7 @@ def identify(
     window = family.resolve_window(window_s, max(float(r.time[-1] - r.time[0]) for r in runs))
     say = progress or (lambda _msg: None)
     ctx = family.prepare(runs if family.multi_run else runs[0], float(holdout), window)
+    window = getattr(ctx, "window_s", window)  # a family may resolve "auto" from the record
 
     t0 = time.perf_counter()
     base = current = family.fit_base(ctx, say)

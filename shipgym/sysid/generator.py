@@ -745,3 +745,228 @@ def _rvg_record(
         rpm=rpm,
         meta=meta,
     )
+
+
+# --------------------------------------------------------------------------------------------
+# 3-DOF model tests: several runs of one VMM ship
+
+
+VMM_EFFECTS: tuple[str, ...] = ("current", "wind", "rudder_slipstream")
+"""Undeclared effects of :func:`generate_vmm_runs` (the identification effects of
+:mod:`shipgym.sysid.families.vmm` that change the motions)."""
+
+VMM_EFFECT_TERMS: dict[str, dict[str, float]] = {
+    # apparent wind on a model at about 3 m/s relative wind: a side force of 20-30 % of the
+    # rudder's at 10 deg (Esso Osaka in the pond: wind 1.3-2.3 m/s, ship 0.2-0.55 m/s)
+    "wind": {"X_wc": -8e-6, "Y_ws": -2e-5, "N_w2": -3e-6},
+    # the rudder in the slipstream (the HSVA KVLCC2 fit of martin_simple: Y_Td -1.1, N_Td 0.45)
+    "rudder_slipstream": {"Y_Td": -1.0, "N_Td": 0.45},
+}
+"""Terms (prime coefficients at ``magnitude`` 1) of the effects that are terms."""
+
+VMM_CURRENT_SPEED = 0.1
+"""Default current [m/s] of :func:`generate_vmm_runs` (8 % of the 7 m model's speed)."""
+
+VMM_TRUE_WIND = (2.0, math.radians(60.0))
+"""True wind of :func:`generate_vmm_runs`: speed [m/s] and the direction it comes from [rad]."""
+
+VMM_NOISE: dict[str, float] = {
+    "psi": math.radians(0.1),
+    "r": math.radians(0.05),
+    "uv": 0.003,
+    "xy": 0.01,
+    "thrust": 0.5,
+    "wind_speed": 0.1,
+    "wind_angle": math.radians(2.0),
+}
+"""Standard deviations of the sensor noise of :func:`generate_vmm_runs`."""
+
+#: The run programme: (kind, rudder angle [deg], switch heading [deg] or hold [s], side).
+VMM_RUNS: tuple[tuple[str, float, float, float], ...] = (
+    ("zigzag", 10.0, 10.0, 1.0),
+    ("zigzag", 20.0, 20.0, -1.0),
+    ("turning", 35.0, 60.0, 1.0),
+    ("zigzag", 30.0, 5.0, -1.0),
+    ("random", 25.0, 12.0, 1.0),
+    ("zigzag", 20.0, 10.0, 1.0),
+    ("turning", 25.0, 60.0, -1.0),
+    ("random", 30.0, 8.0, -1.0),
+)
+
+
+def vmm_truth() -> Any:
+    """The known ship of :func:`generate_vmm_runs`: the 7 m KVLCC2's particulars with a
+    stable linear term set (hull derivatives of Yasukawa and Yoshimura 2015 in the seed's
+    prime system, ``N_r`` raised to make it course-stable; rudder and thrust terms of the HSVA
+    fits)."""
+    from shipgym.sysid.families.vmm import vessel_params
+
+    template = vessel_params(Record([0.0, 1.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0],
+                                    meta={"source": "hsva"}))  # fmt: skip
+    coefficients = {
+        "X_u": -0.0011, "X_v": 0.0, "X_r": 0.0, "X_d": 0.0, "X_T": 0.78,
+        "Y_u": 0.0, "Y_v": -0.0205, "Y_r": 0.0054, "Y_d": -0.0032,
+        "N_u": 0.0, "N_v": -0.0089, "N_r": -0.008, "N_d": 0.0015,
+    }  # fmt: skip
+    return template.with_coefficients(coefficients, name="generated KVLCC2-like ship")
+
+
+def generate_vmm_runs(
+    effect: str | None = None,
+    *,
+    n_runs: int = 6,
+    dt: float = 0.1,
+    noise: bool = True,
+    seed: int = 0,
+    magnitude: float = 1.0,
+) -> list[Record]:
+    """Several runs of the known 3-DOF ship of :func:`vmm_truth` with at most one undeclared
+    effect: zigzags, turning circles and random rudder, in the order of :data:`VMM_RUNS`.
+
+    Each run starts at the approach speed on a straight course and is simulated through
+    :func:`shipgym.models.make_model` ``("vmm", ...)`` with the manoeuvre as a controller. The
+    propeller runs at constant revolutions: its thrust rises as the ship slows,
+    ``T = T_0 (1.3 - 0.3 u / U_0)``, recorded in ``thrust``.
+
+    Parameters
+    ----------
+    effect : {"current", "wind", "rudder_slipstream"} or None
+        ``current``: a constant current of :data:`VMM_CURRENT_SPEED` x ``magnitude`` toward a
+        direction drawn from the seed; ``wind``: the true wind :data:`VMM_TRUE_WIND` with the
+        terms of :data:`VMM_EFFECT_TERMS` x ``magnitude`` (the records carry the apparent
+        wind); ``rudder_slipstream``: its terms x ``magnitude``.
+    n_runs : int
+        Number of runs (1 .. 8).
+    dt : float
+        Sampling interval [s] (0.01 .. 0.5; the 7 m model's ``L / U`` is 5.9 s).
+    noise : bool
+        Add the sensor noise :data:`VMM_NOISE`.
+    seed : int
+        Seed of the current direction, the random rudder and the noise.
+    magnitude : float
+        Size of the effect relative to its default (> 0).
+
+    Returns
+    -------
+    list of Record
+        ``time, delta, psi, r, x, y, u, v, U, thrust`` (and ``wind_speed``, ``wind_angle``
+        with ``effect="wind"``); ``meta["particulars"]`` holds the ship (no coefficients) so
+        that identification can read it, ``meta["truth"]`` the true model and effect, for
+        tests only.
+    """
+    from shipgym.models import make_model
+
+    if effect is not None and effect not in VMM_EFFECTS:
+        raise ValueError(f"unknown effect {effect!r}; expected None or one of {VMM_EFFECTS}")
+    if not (isinstance(n_runs, int) and 1 <= n_runs <= len(VMM_RUNS)):
+        raise ValueError(f"n_runs must be an integer in [1, {len(VMM_RUNS)}], got {n_runs!r}")
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and 0.01 <= dt <= 0.5):
+        raise ValueError(f"dt must be in [0.01, 0.5] s, got {dt!r}")
+    if not (isinstance(magnitude, int | float) and math.isfinite(magnitude) and magnitude > 0):
+        raise ValueError(f"magnitude must be a finite number > 0, got {magnitude!r}")
+    rng_cur, rng_man, rng_noise = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(int(seed)).spawn(3)
+    )
+    truth = vmm_truth()
+    coefficients = dict(truth.coefficients)
+    current = np.zeros(2)
+    effect_params: dict[str, Any] = {}
+    if effect == "current":
+        current, effect_params = _draw_current(rng_cur, VMM_CURRENT_SPEED * magnitude)
+    elif effect is not None:
+        effect_params = {k: v * magnitude for k, v in VMM_EFFECT_TERMS[effect].items()}
+        coefficients.update(effect_params)
+    ship = truth.with_coefficients(coefficients)
+    model = make_model("vmm", ship)
+    u0 = ship.approach_speed
+    thrust0 = truth.approach_thrust()
+    wind_true = effect == "wind"
+    w_speed, w_from = VMM_TRUE_WIND
+    particulars = {k: v for k, v in truth.to_dict().items() if k != "coefficients"}
+    h = dt / max(1, math.ceil(dt / 0.05 - 1e-9))  # integration step <= 0.05 s
+    every = round(dt / h)
+    records = []
+    for k, (kind, angle_deg, b, side) in enumerate(VMM_RUNS[:n_runs]):
+        angle = math.radians(angle_deg)
+        duration = 150.0 if kind != "turning" else 120.0
+        n_fine = round(duration / h)
+        state = {"sign": side, "levels": None}
+        if kind == "random":
+            times = np.arange(0.0, duration + b, b)
+            state["levels"] = (times, rng_man.uniform(-angle, angle, times.size))
+
+        def apparent(x: np.ndarray) -> tuple[float, float]:
+            if not wind_true:
+                return 0.0, 0.0
+            # relative air velocity in the body frame: true wind minus the ship's velocity
+            psi = x[2]
+            wx, wy = -w_speed * math.cos(w_from), -w_speed * math.sin(w_from)  # blowing to
+            ax = wx * math.cos(psi) + wy * math.sin(psi) - x[3]
+            ay = -wx * math.sin(psi) + wy * math.cos(psi) - x[4]
+            return math.hypot(ax, ay), math.atan2(-ay, -ax)  # angle it comes from, off the bow
+
+        def controller(
+            t: float, x: np.ndarray, kind: str = kind, angle: float = angle, b: float = b,
+            state: dict[str, Any] = state, duration: float = duration,
+        ) -> np.ndarray:  # fmt: skip
+            if kind == "zigzag":
+                psi_deg = math.degrees(x[2])
+                if state["sign"] > 0 and psi_deg > b:
+                    state["sign"] = -1.0
+                elif state["sign"] < 0 and psi_deg < -b:
+                    state["sign"] = 1.0
+                delta = state["sign"] * angle
+            elif kind == "turning":
+                delta = state["sign"] * angle if t < duration - b else 0.0
+            else:
+                times, levels = state["levels"]
+                delta = float(levels[np.searchsorted(times, t, side="right") - 1])
+            thrust = thrust0 * (1.3 - 0.3 * x[3] / u0)
+            return np.array([delta, thrust, *apparent(x)])
+
+        x0 = np.zeros(7)
+        x0[3] = u0
+        res = model.simulate(x0, controller, h, n_fine, current=current)
+        sel = slice(None, None, every)
+        st = res.states[sel]
+        inp = np.vstack((res.inputs, res.inputs[-1:]))[sel]
+        n = st.shape[0]
+
+        def noisy(a: np.ndarray, key: str, n: int = n) -> np.ndarray:
+            return a + rng_noise.normal(0.0, VMM_NOISE[key], n) if noise else a
+
+        u, v = noisy(st[:, 3], "uv"), noisy(st[:, 4], "uv")
+        extra: dict[str, np.ndarray] = {}
+        if wind_true:
+            extra["wind_speed"] = np.abs(noisy(inp[:, 2], "wind_speed"))
+            angle_noisy = noisy(inp[:, 3], "wind_angle")
+            extra["wind_angle"] = -((-angle_noisy + math.pi) % (2.0 * math.pi) - math.pi)
+        records.append(
+            Record(
+                time=res.time[sel],
+                delta=st[:, 6],
+                psi=noisy(st[:, 2], "psi"),
+                r=noisy(st[:, 5], "r"),
+                x=noisy(st[:, 0], "xy"),
+                y=noisy(st[:, 1], "xy"),
+                u=u,
+                v=v,
+                U=np.hypot(u, v),
+                thrust=noisy(inp[:, 1], "thrust"),
+                **extra,
+                meta={
+                    "source": "generated",
+                    "file": f"generated run {k + 1} ({kind} {angle_deg:g})",
+                    "vessel": ship.name,
+                    "L": ship.length,
+                    "scale": "model",
+                    "particulars": particulars,
+                    "truth": {
+                        "coefficients": coefficients,
+                        "effect": effect,
+                        "effect_parameters": effect_params,
+                    },
+                },
+            )
+        )
+    return records
