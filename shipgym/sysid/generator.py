@@ -767,8 +767,8 @@ VMM_EFFECT_TERMS: dict[str, dict[str, float]] = {
 VMM_CURRENT_SPEED = 0.1
 """Default current [m/s] of :func:`generate_vmm_runs` (8 % of the 7 m model's speed)."""
 
-VMM_TRUE_WIND = (2.0, math.radians(60.0))
-"""True wind of :func:`generate_vmm_runs`: speed [m/s] and the direction it comes from [rad]."""
+VMM_TRUE_WIND_SPEED = 3.0
+"""True wind speed [m/s] of :func:`generate_vmm_runs` (its direction is drawn from the seed)."""
 
 VMM_NOISE: dict[str, float] = {
     "psi": math.radians(0.1),
@@ -832,8 +832,9 @@ def generate_vmm_runs(
     ----------
     effect : {"current", "wind", "rudder_slipstream"} or None
         ``current``: a constant current of :data:`VMM_CURRENT_SPEED` x ``magnitude`` toward a
-        direction drawn from the seed; ``wind``: the true wind :data:`VMM_TRUE_WIND` with the
-        terms of :data:`VMM_EFFECT_TERMS` x ``magnitude`` (the records carry the apparent
+        direction drawn from the seed; ``wind``: a true wind of :data:`VMM_TRUE_WIND_SPEED` from
+        a direction drawn from the seed, with the terms of :data:`VMM_EFFECT_TERMS` x
+        ``magnitude`` (the records carry the apparent
         wind); ``rudder_slipstream``: its terms x ``magnitude``.
     n_runs : int
         Number of runs (1 .. 8).
@@ -881,7 +882,10 @@ def generate_vmm_runs(
     u0 = ship.approach_speed
     thrust0 = truth.approach_thrust()
     wind_true = effect == "wind"
-    w_speed, w_from = VMM_TRUE_WIND
+    w_speed = VMM_TRUE_WIND_SPEED
+    w_from = float(rng_cur.uniform(0.0, 2.0 * math.pi)) if wind_true else 0.0
+    if wind_true:
+        effect_params["wind_from"] = w_from
     particulars = {k: v for k, v in truth.to_dict().items() if k != "coefficients"}
     h = dt / max(1, math.ceil(dt / 0.05 - 1e-9))  # integration step <= 0.05 s
     every = round(dt / h)

@@ -14,8 +14,13 @@ The seed's identification, through the one engine (:mod:`shipgym.sysid.engine`):
    length as lag, since the residual of filtered derivatives is correlated over that length; the
    condition number of the kept regressors is reported per equation.
 2. **Output-error refinement** (:func:`refine`): the regression result is the start of a
-   weighted least-squares fit of the simulated ``psi, r, u, v`` to the measurement, run by run
-   (windows of ``window_s`` for long runs, each from the measured state), as the Nomoto fits do.
+   weighted least-squares fit of the simulated ``psi, r, u, v`` to the measurement over windows
+   of :data:`REFINE_WINDOW_LENGTHS` ship lengths (multiple shooting), estimating each window's
+   initial sway and yaw rate with the coefficients, as the Nomoto fits estimate the initial
+   state. Held-out runs are predicted in windows of ``window_s`` (:data:`VMMFamily.window_lengths`
+   ship lengths by default), each window's initial sway and yaw rate estimated from that window
+   with the coefficients fixed (:func:`predict`, as a validation on new data estimates its
+   initial condition).
 3. **Cross-validation across runs**: the engine fits on some runs and scores on the others
    (:meth:`VMMFamily.prepare`: every ``1/holdout``-th run is held out; a single run is split in
    time). Effects (:data:`VMM_EFFECTS`): ``asymmetry`` (constant side force and moment: the
@@ -86,9 +91,18 @@ FILTER_LENGTHS = 0.15
 COLLINEAR_RCOND = 1e-3
 """Relative pivot below which a term is collinear with the kept ones (normalised columns)."""
 
-STEP_LENGTHS = 0.03
+STEP_LENGTHS = 0.05
 """Replay step of the output-error fits, in ship lengths of travel (the record is thinned to
-about this step: 0.18 s on the 7 m model at 1.18 m/s)."""
+about this step: 0.3 s on the 7 m model at 1.18 m/s, 2 s at full scale)."""
+
+REFINE_WINDOW_LENGTHS = 5.0
+"""Window of the output-error refinement in ship lengths of travel: multiple shooting over
+short windows keeps the cost smooth where a near-unstable ship makes long free runs diverge
+from a poor start (scoring uses the longer ``window_s``)."""
+
+SCREEN_MIN_DROP = 0.01
+"""Smallest relative drop of the equation error (mean ``1 - R^2`` of X, Y, N on the training
+runs) for which a candidate effect is refined by output error and judged by simulation."""
 
 START_PRIOR = 0.005
 """Prior standard deviation of the estimated initial sway (``START_PRIOR U``) and yaw rate
@@ -613,7 +627,13 @@ def replay(
 
 
 def _channel_errors(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
-    """``(4, n)`` errors of ``psi`` (wrapped), ``r``, ``u``, ``v``."""
+    """``(4, n)`` errors of ``psi`` (wrapped), ``r``, ``u``, ``v`` (non-finite where the
+    simulation diverged)."""
+    with np.errstate(all="ignore"):
+        return _errors_unchecked(sim, meas)
+
+
+def _errors_unchecked(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
     return np.vstack((
         wrap(sim[:, 2] - meas[:, 2]), sim[:, 5] - meas[:, 5], sim[:, 3] - meas[:, 3],
         sim[:, 4] - meas[:, 4],
@@ -707,7 +727,98 @@ def fit_vmm(
     return fit
 
 
-def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 30) -> VMMFit:
+def _start_columns(
+    rp: _Replay, mask: np.ndarray, windows: list[int], n_c: int
+) -> tuple[Any, np.ndarray]:
+    """Jacobian sparsity of the channel residuals (``4 x n_obs`` rows, then the start priors)
+    over ``n_c`` dense columns and two start columns (``v``, ``r``) per window, and the
+    prior scale rows."""
+    from scipy.sparse import lil_matrix
+
+    n_obs = int(mask.sum())
+    sample_window = np.searchsorted(rp.starts, np.flatnonzero(mask), side="right") - 1
+    col_of_window = {w: n_c + 2 * j for j, w in enumerate(windows)}
+    cols = np.array([col_of_window[w] for w in sample_window])
+    sparsity = lil_matrix((4 * n_obs + 2 * len(windows), n_c + 2 * len(windows)), dtype=np.int8)
+    sparsity[: 4 * n_obs, :n_c] = 1
+    for ch in range(4):
+        rows = ch * n_obs + np.arange(n_obs)
+        sparsity[rows, cols] = 1
+        sparsity[rows, cols + 1] = 1
+    k = np.arange(2 * len(windows))
+    sparsity[4 * n_obs + k, n_c + k] = 1
+    return sparsity, cols
+
+
+def _windows_of(rp: _Replay, runs: Sequence[int]) -> list[int]:
+    keep = set(runs)
+    return [w for w in range(rp.starts.size) if rp.run_of[rp.starts[w]] in keep]
+
+
+def _fit_windows(
+    rp: _Replay,
+    runs: Sequence[int],
+    sigma: np.ndarray,
+    start_scale: np.ndarray,
+    model: Callable[[np.ndarray], tuple[VMMParams, tuple[float, float]]],
+    theta0: np.ndarray,
+    theta_scale: np.ndarray,
+    max_nfev: int,
+) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Weighted least squares of the simulated ``psi, r, u, v`` of the windows of ``runs``
+    over ``theta`` (the parameters ``model`` maps to a ship and a current) and the initial
+    sway and yaw rate of every window (with a prior of ``start_scale``).
+
+    Returns the solution (``theta``), the start states ``x0``, and the costs before and after.
+    """
+    mask = rp.run_mask(runs)
+    meas = rp.measured[mask]
+    windows = _windows_of(rp, runs)
+    n_c = theta0.size
+    sparsity, _ = _start_columns(rp, mask, windows, n_c)
+
+    def starts(th: np.ndarray) -> np.ndarray:
+        x0 = rp.x0.copy()
+        d = th[n_c:].reshape(-1, 2)
+        x0[windows, 4] += d[:, 0]
+        x0[windows, 5] += d[:, 1]
+        return x0
+
+    def resid(th: np.ndarray) -> np.ndarray:
+        params, cur = model(th[:n_c])
+        sim = replay(rp, params, cur, starts(th))[mask]
+        e = _channel_errors(sim, meas) / sigma[:, None]
+        e = np.clip(np.where(np.isfinite(e), e, 1e3), -1e3, 1e3).ravel()
+        return np.concatenate((e, (th[n_c:].reshape(-1, 2) / start_scale).ravel()))
+
+    th0 = np.concatenate((theta0, np.zeros(2 * len(windows))))
+    r0 = resid(th0)
+    sol = least_squares(
+        resid, th0, x_scale=np.concatenate((theta_scale, np.tile(start_scale, len(windows)))),
+        method="trf", max_nfev=max_nfev, jac_sparsity=sparsity, xtol=1e-6, ftol=1e-6,
+    )  # fmt: skip
+    return sol.x[:n_c], starts(sol.x), 0.5 * float(r0 @ r0), float(sol.cost)
+
+
+def _start_scale(rp: _Replay, length: float) -> np.ndarray:
+    u_ref = float(np.median(np.abs(rp.measured[:, 3]))) or 1.0
+    return np.array([START_PRIOR * u_ref, START_PRIOR * u_ref / length])
+
+
+def _channel_sigma(rp: _Replay, runs: Sequence[int], fit: VMMFit) -> np.ndarray:
+    """Channel weights: each channel's RMS error of ``fit`` replayed from the measured starts
+    (floored at a thousandth of the channel's spread)."""
+    mask = rp.run_mask(runs)
+    meas = rp.measured[mask]
+    spread = np.array([meas[:, 2].std(), meas[:, 5].std(), meas[:, 3].std(), meas[:, 4].std()])
+    e = _channel_errors(replay(rp, fit.params, fit.current)[mask], meas)
+    with np.errstate(all="ignore"):
+        rms = np.sqrt(np.mean(np.where(np.isfinite(e), e, np.inf) ** 2, axis=1))
+    rms = np.where(np.isfinite(rms), rms, spread)
+    return np.maximum(np.minimum(rms, spread), 1e-3 * np.maximum(spread, 1e-9))
+
+
+def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20) -> VMMFit:
     """Output-error refinement of ``fit`` on the runs ``fit_runs`` (module docstring).
 
     Weighted least squares of the simulated ``psi, r, u, v`` from the regression result (each
@@ -716,72 +827,42 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 30
     near-unstable ship turns a start error of a few hundredths of a degree per second into
     degrees of heading, which the coefficients would otherwise absorb. The initial-state
     corrections carry a prior of :data:`START_PRIOR` (about the measurement noise). Returns
-    ``fit`` itself when the refinement does not halve the cost of the start.
+    ``fit`` itself when the refinement does not lower the cost of the start.
     """
-    from scipy.sparse import lil_matrix
-
-    mask = rp.run_mask(fit_runs)
-    meas = rp.measured[mask]
-    n_obs = int(mask.sum())
-    free = [k for k, v in fit.params.coefficients.items() if k not in fit.regression.collinear]
+    free = [k for k in fit.params.coefficients if k not in fit.regression.collinear]
     extra = ["V_x", "V_y"] if "current" in fit.effects else []
-    windows = [w for w in range(rp.starts.size) if rp.run_of[rp.starts[w]] in set(fit_runs)]
-    n_c = len(free) + len(extra)
-    u_ref = float(np.median(np.abs(meas[:, 3]))) or 1.0
-    length = fit.params.length
-    start_scale = np.array([START_PRIOR * u_ref, START_PRIOR * u_ref / length])
-    th0 = np.concatenate((
-        [fit.params.coefficients[k] for k in free], [fit.values[k] for k in extra],
-        np.zeros(2 * len(windows)),
-    ))  # fmt: skip
-    scale = np.concatenate((
+    theta0 = np.array([fit.params.coefficients[k] for k in free]
+                      + [fit.values[k] for k in extra])  # fmt: skip
+    scale = np.array(
         [max(abs(fit.params.coefficients[k]), fit.stderr.get(k, 0.0) or 0.0, 1e-6)
-         for k in free],
-        [0.01] * len(extra), np.tile(start_scale, len(windows)),
-    ))  # fmt: skip
-    sigma = np.array([meas[:, 2].std(), meas[:, 5].std(), meas[:, 3].std(), meas[:, 4].std()])
-    sigma = np.maximum(sigma, 1e-6)
-    # the window of every scored sample, for the sparsity of the initial-state columns
-    sample_window = np.searchsorted(rp.starts, np.flatnonzero(mask), side="right") - 1
-    col_of_window = {w: n_c + 2 * j for j, w in enumerate(windows)}
-    n_res = 4 * n_obs + 2 * len(windows)
-    sparsity = lil_matrix((n_res, th0.size), dtype=np.int8)
-    sparsity[: 4 * n_obs, :n_c] = 1
-    for ch in range(4):
-        rows = ch * n_obs + np.arange(n_obs)
-        cols = np.array([col_of_window[w] for w in sample_window])
-        sparsity[rows, cols] = 1
-        sparsity[rows, cols + 1] = 1
-    sparsity[4 * n_obs + np.arange(2 * len(windows)), n_c + np.arange(2 * len(windows))] = 1
+         for k in free] + [0.01] * len(extra)
+    )  # fmt: skip
 
-    def build(th: np.ndarray) -> tuple[VMMParams, tuple[float, float], np.ndarray]:
+    def model(th: np.ndarray) -> tuple[VMMParams, tuple[float, float]]:
         coeffs = dict(fit.params.coefficients)
         coeffs.update(zip(free, th[: len(free)], strict=True))
-        vals = dict(zip(extra, th[len(free) : n_c], strict=True))
-        x0 = rp.x0.copy()
-        d = th[n_c:].reshape(-1, 2)
-        x0[windows, 4] += d[:, 0]
-        x0[windows, 5] += d[:, 1]
-        params = fit.params.with_coefficients(coeffs)
-        return params, (vals.get("V_x", 0.0), vals.get("V_y", 0.0)), x0
+        vals = dict(zip(extra, th[len(free) :], strict=True))
+        return fit.params.with_coefficients(coeffs), (vals.get("V_x", 0.0), vals.get("V_y", 0.0))
 
-    def resid(th: np.ndarray) -> np.ndarray:
-        params, cur, x0 = build(th)
-        sim = replay(rp, params, cur, x0)[mask]
-        e = _channel_errors(sim, meas) / sigma[:, None]
-        e = np.clip(np.where(np.isfinite(e), e, 1e3), -1e3, 1e3).ravel()
-        prior = (th[n_c:].reshape(-1, 2) / start_scale).ravel()
-        return np.concatenate((e, prior))
-
-    r0 = resid(th0)  # reweight: each channel by its RMS error of the start
-    sigma = sigma * np.maximum(np.sqrt(np.mean(r0[: 4 * n_obs].reshape(4, -1) ** 2, axis=1)), 1e-3)
-    r0 = resid(th0)
-    sol = least_squares(resid, th0, x_scale=scale, method="trf", max_nfev=max_nfev,
-                        jac_sparsity=sparsity, xtol=1e-6, ftol=1e-6)  # fmt: skip
-    if not float(sol.cost) < 0.25 * float(r0 @ r0):  # cost is half the sum of squares
+    theta, _, before, after = _fit_windows(
+        rp, fit_runs, _channel_sigma(rp, fit_runs, fit), _start_scale(rp, fit.params.length),
+        model, theta0, scale, max_nfev,
+    )  # fmt: skip
+    if not after < before:
         return fit
-    params, cur, _ = build(sol.x)
+    params, cur = model(theta)
     return replace(fit, params=params, current=cur, refined=True)
+
+
+def predict(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray:
+    """Replay of ``fit`` with the initial sway and yaw rate of every window of ``runs``
+    estimated from that window (the coefficients fixed; as a validation of a model on new
+    data estimates its initial condition), the measured starts elsewhere."""
+    _, x0, _, _ = _fit_windows(
+        rp, runs, _channel_sigma(rp, runs, fit), _start_scale(rp, fit.params.length),
+        lambda _th: (fit.params, fit.current), np.zeros(0), np.zeros(0), 20,
+    )  # fmt: skip
+    return replay(rp, fit.params, fit.current, x0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -791,19 +872,26 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 30
 @dataclass
 class _Context:
     runs: list[_Run]
-    rp: _Replay
+    rp: _Replay  # scoring windows
+    rp_fit: _Replay  # the refinement's shorter windows (multiple shooting)
     train: list[int]
     held: list[int]
     template: VMMParams
     window_s: float | None
 
 
+def _equation_error(fit: VMMFit) -> float:
+    """Mean ``1 - R^2`` of the regression's three equations."""
+    return float(np.mean([1.0 - v for v in fit.regression.r2.values()]))
+
+
 def _rms(sim: np.ndarray, meas: np.ndarray) -> dict[str, float]:
     """RMS errors of a replay: ``psi_rms_deg``, ``r_rms_deg_s``, ``u_rms_m_s``, ``v_rms_m_s``
     and the position error ``xy_rms_m``."""
-    e = _channel_errors(sim, meas) ** 2
-    d2 = (sim[:, 0] - meas[:, 0]) ** 2 + (sim[:, 1] - meas[:, 1]) ** 2
-    rms = np.sqrt(np.mean(e, axis=1))
+    with np.errstate(all="ignore"):
+        e = _channel_errors(sim, meas) ** 2
+        d2 = (sim[:, 0] - meas[:, 0]) ** 2 + (sim[:, 1] - meas[:, 1]) ** 2
+        rms = np.sqrt(np.mean(e, axis=1))
     return {
         "psi_rms_deg": math.degrees(float(rms[0])),
         "r_rms_deg_s": math.degrees(float(rms[1])),
@@ -883,10 +971,16 @@ class VMMFamily(ModelFamily):
                                                     for r in runs])))  # fmt: skip
             window_s = self.window_lengths * template.length / max(speed, 1e-3)
         rp = _build_replay(runs, template, window_s)
-        return _Context(runs, rp, train, held, template, window_s)
+        speed = float(np.median(np.concatenate([np.hypot(r.states[:, 3], r.states[:, 4])
+                                                for r in runs])))  # fmt: skip
+        shooting = REFINE_WINDOW_LENGTHS * template.length / max(speed, 1e-3)
+        rp_fit = _build_replay(runs, template, min(shooting, window_s or math.inf))
+        return _Context(runs, rp, rp_fit, train, held, template, window_s)
 
     def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
-        sim = replay(ctx.rp, fit.params, fit.current)
+        """Held-out runs replayed with each window's initial sway and yaw rate estimated
+        (:func:`predict`), scored by the BIC of ``psi, r, u, v``."""
+        sim = predict(fit, ctx.rp, ctx.held)
         mask = ctx.rp.run_mask(ctx.held)
         n = int(mask.sum())
         if not np.all(np.isfinite(sim[mask])):
@@ -901,7 +995,7 @@ class VMMFamily(ModelFamily):
     def _fit(
         self, ctx: _Context, effects: Sequence[str], runs: Sequence[int], refine_fit: bool
     ) -> VMMFit:
-        return fit_vmm(ctx.runs, ctx.template, self.term_set, effects, rp=ctx.rp,
+        return fit_vmm(ctx.runs, ctx.template, self.term_set, effects, rp=ctx.rp_fit,
                        fit_runs=runs, refine_fit=refine_fit and self.refine)  # fmt: skip
 
     def _candidate(self, ctx: _Context, effects: Sequence[str], screen: Candidate | None = None
@@ -910,10 +1004,25 @@ class VMMFamily(ModelFamily):
         ``extra["screen"]``)."""
         if screen is None:
             screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False))
-        cand = self._score(ctx, refine(screen.fitted, ctx.rp, ctx.train)) if self.refine else screen
+        if not self.refine:
+            return screen
+        cand = self._score(ctx, refine(screen.fitted, ctx.rp_fit, ctx.train))
         cand.extra.update(screen.extra)
         cand.extra["screen"] = screen
         return cand
+
+    def _refit_all(self, ctx: _Context, cand: Candidate) -> VMMFit:
+        """``cand`` refitted on every run: the regression on every run (its standard errors
+        and collinear terms), refined from the training fit's coefficients."""
+        fit = self._fit(ctx, cand.effects, list(range(len(ctx.runs))), False)
+        if not self.refine:
+            return fit
+        start = fit.params.with_coefficients(
+            {k: (0.0 if k in fit.regression.collinear else v)
+             for k, v in cand.fitted.params.coefficients.items()}
+        )  # fmt: skip
+        warm = replace(fit, params=start, current=cand.fitted.current)
+        return refine(warm, ctx.rp_fit, list(range(len(ctx.runs))))
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         cand = self._candidate(ctx, ())
@@ -922,19 +1031,22 @@ class VMMFamily(ModelFamily):
         return cand
 
     def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
-        """Screened by the regression alone: the candidate's regression-only model against the
-        current model's; one that passes the engine's test there is refined by output error
-        and judged by that fit (the refinement costs 20-50 times the regression)."""
+        """Screened by the regression: a candidate whose terms lower the equation error of the
+        training runs by less than :data:`SCREEN_MIN_DROP` is scored as regressed (the engine
+        then rejects it); the others are refined by output error and judged by that fit (the
+        refinement costs 20-50 times the regression)."""
         if name == "wind" and not all(r.has_wind for r in ctx.runs):
             raise ValueError("the records have no wind channels")
         effects = (*current.effects, name)
-        screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False))
-        cur_screen = current.extra.get("screen", current)
-        dj, drop = self.compare(cur_screen, screen, name)
-        screen.extra.update(screen_delta_J=dj, screen_relative_drop=drop)
-        if not self.refine or not self.significant(screen, name, dj, drop):
-            return screen
-        return self._candidate(ctx, effects, screen)
+        fit = self._fit(ctx, effects, ctx.train, False)
+        drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
+        if not self.refine or drop < SCREEN_MIN_DROP:
+            cand = self._score(ctx, fit)
+            cand.extra["screen_equation_error_drop"] = drop
+            return cand
+        cand = self._candidate(ctx, effects, self._score(ctx, fit))
+        cand.extra["screen_equation_error_drop"] = drop
+        return cand
 
     def effect_parameters(self, fitted: VMMFit, name: str) -> dict[str, float]:
         vals = fitted.values
@@ -951,23 +1063,28 @@ class VMMFamily(ModelFamily):
     ) -> dict[str, Any]:
         everything = list(range(len(ctx.runs)))
         say("fits of the base and final models on every run")
-        base_full = self._fit(ctx, (), everything, True)
-        final_full = self._fit(ctx, final.effects, everything, True) if final.effects else base_full
+        base_full = self._refit_all(ctx, base)
+        final_full = self._refit_all(ctx, final) if final.effects else base_full
         sims = {
-            "before": replay(ctx.rp, base_full.params, base_full.current),
-            "after": replay(ctx.rp, final_full.params, final_full.current),
+            "before": predict(base_full, ctx.rp, everything),
+            "after": predict(final_full, ctx.rp, everything),
         }
         every = ctx.rp.run_mask(everything)
         held_mask = ctx.rp.run_mask(ctx.held)
+        held_sims = {
+            "before": predict(base.fitted, ctx.rp, ctx.held),
+            "after": predict(final.fitted, ctx.rp, ctx.held),
+        }
         heldout = {
             "runs": [ctx.runs[i].name for i in ctx.held],
-            "error_before": _rms(replay(ctx.rp, base.fitted.params, base.fitted.current)[held_mask],
-                                 ctx.rp.measured[held_mask]),
-            "error_after": _rms(
-                replay(ctx.rp, final.fitted.params, final.fitted.current)[held_mask],
-                ctx.rp.measured[held_mask],
-            ),
-        }  # fmt: skip
+            "error_before": _rms(held_sims["before"][held_mask], ctx.rp.measured[held_mask]),
+            "error_after": _rms(held_sims["after"][held_mask], ctx.rp.measured[held_mask]),
+            "per_run": {
+                ctx.runs[i].name: _rms(held_sims["after"][m], ctx.rp.measured[m])
+                for i in ctx.held
+                for m in [ctx.rp.run_mask([i])]
+            },
+        }
         per_run = {}
         for i, run in enumerate(ctx.runs):
             m = ctx.rp.run_mask([i])

@@ -1,0 +1,307 @@
+"""Seed 003's general 3-DOF model (shipgym.models.vmm) and its identification
+(shipgym.sysid.families.vmm): physics against closed forms and invariants, the regression and
+the loop against generated records of a known ship, the measured KVLCC2 records, the CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipgym.cli import main
+from shipgym.maneuvers import turning_circle, zigzag
+from shipgym.models import VMMParams, make_model
+from shipgym.models.vmm import (
+    FACTORS,
+    TERM_SETS,
+    clarke_added_masses,
+    pack_vmm,
+    parse_term,
+    term_matrix,
+)
+from shipgym.sysid import identify, load
+from shipgym.sysid.families.vmm import prepare_runs, regress, vessel_params
+from shipgym.sysid.generator import generate_vmm_runs, vmm_truth
+
+MEASURED = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
+HSVA = sorted((MEASURED / "hsva_kvlcc2").glob("*.dat"))
+
+
+# ------------------------------------------------------------------------------------------
+# terms
+
+
+def test_term_names_parse_to_factor_exponents() -> None:
+    eq, e = parse_term("Y_vvr")
+    assert eq == 1 and e[FACTORS.index("v")] == 2 and e[FACTORS.index("r")] == 1
+    eq, e = parse_term("N_v|r|")
+    assert eq == 2 and e[FACTORS.index("v")] == 1 and e[FACTORS.index("|r|")] == 1
+    eq, e = parse_term("Y_0")
+    assert eq == 1 and not e.any()
+    for names in TERM_SETS.values():
+        assert term_matrix(names).shape == (len(names), 1 + len(FACTORS))
+        assert len(set(names)) == len(names)
+
+
+@pytest.mark.parametrize("bad", ["Z_v", "Y_", "Y_vq", "Yv", "X_v0", 3])
+def test_bad_term_names_are_refused(bad: object) -> None:
+    with pytest.raises(ValueError, match="term"):
+        parse_term(bad)  # type: ignore[arg-type]
+
+
+def test_abkowitz_set_is_the_third_order_expansion_with_thrust() -> None:
+    names = TERM_SETS["abkowitz"]
+    assert "X_T" in names and "Y_vvv" in names and "N_vrd" in names
+    for name in names:  # third order at most in the motions (thrust counts as a load)
+        _, e = parse_term(name)
+        assert e[:4].sum() <= 3
+
+
+# ------------------------------------------------------------------------------------------
+# physics
+
+
+def _ship(**coefficients: float) -> VMMParams:
+    return vmm_truth().with_coefficients({**vmm_truth().coefficients, **coefficients})
+
+
+def test_straight_running_at_the_approach_thrust_holds_the_speed() -> None:
+    ship = _ship()
+    model = make_model("vmm", ship)
+    x = np.array([0.0, 0.0, 0.3, ship.approach_speed, 0.0, 0.0, 0.0])
+    d = model.deriv(x, [0.0, ship.approach_thrust(), 0.0, 0.0])[0]
+    assert d[3] == pytest.approx(0.0, abs=1e-12)
+    assert d[4] == pytest.approx(0.0, abs=1e-12) and d[5] == pytest.approx(0.0, abs=1e-12)
+    assert d[0] == pytest.approx(ship.approach_speed * math.cos(0.3), rel=1e-12)
+
+
+def test_sway_yaw_accelerations_solve_the_seed_system() -> None:
+    """The seed's eq_system: [m - Yv', m xG - Yr'; m xG - Nv', Iz - Nr'] [v', r'] =
+    [Y_D - m r u; N_D - m xG r u] with C_A written out, here with the linear terms."""
+    ship = _ship()
+    q = ship
+    model = make_model("vmm", replace(q, direct_rudder=True))
+    u, v, r, delta = 1.1, 0.05, 0.02, math.radians(10.0)
+    big_u = math.hypot(u, v)
+    c = q.coefficients
+    half = 0.5 * q.rho
+    qf, qm = half * q.length**2 * big_u**2, half * q.length**3 * big_u**2
+    vp, rp, up = v / big_u, r * q.length / big_u, u / big_u
+    y_d = qf * (c["Y_u"] * up + c["Y_v"] * vp + c["Y_r"] * rp + c["Y_d"] * delta)
+    n_d = qm * (c["N_u"] * up + c["N_v"] * vp + c["N_r"] * rp + c["N_d"] * delta)
+    a = q.added
+    xud = a["X_udot"] * half * q.length**3
+    yvd, yrd = a["Y_vdot"] * half * q.length**3, a["Y_rdot"] * half * q.length**4
+    nvd, nrd = a["N_vdot"] * half * q.length**4, a["N_rdot"] * half * q.length**5
+    m, xg = q.mass, q.x_g
+    iz = q.yaw_inertia + m * xg**2
+    mat = np.array([[m - yvd, m * xg - yrd], [m * xg - nvd, iz - nrd]])
+    rhs = np.array([
+        y_d - m * r * u + xud * u * r,
+        n_d - m * xg * r * u + (yvd * v + yrd * r) * u - xud * u * v,
+    ])  # fmt: skip
+    expected = np.linalg.solve(mat, rhs)
+    d = model.deriv([0, 0, 0, u, v, r, 0], [delta, 0.0, 0.0, 0.0])[0]
+    np.testing.assert_allclose(d[4:6], expected, rtol=1e-12)
+
+
+def test_munk_moment_from_the_added_masses_alone() -> None:
+    """No hydrodynamic terms: a drifting hull feels the Munk moment (Y_v' - X_u') u v."""
+    ship = replace(_ship(), coefficients={}, direct_rudder=True)
+    p = pack_vmm(ship)
+    u, v = 1.0, 0.1
+    d = make_model("vmm", ship).deriv([0, 0, 0, u, v, 0, 0], [0, 0, 0, 0])[0]
+    half = 0.5 * ship.rho * ship.length**3
+    munk = (ship.added["Y_vdot"] - ship.added["X_udot"]) * half * u * v
+    inv = p[1:5].reshape(2, 2)
+    np.testing.assert_allclose(d[4:6], inv @ np.array([0.0, munk]), rtol=1e-12)
+    no_ca = make_model("vmm", replace(ship, include_c_a=False))
+    assert np.allclose(no_ca.deriv([0, 0, 0, u, v, 0, 0], [0, 0, 0, 0])[0][4:6], 0.0)
+
+
+def test_froude_scaling_keeps_the_turning_circle_in_ship_lengths() -> None:
+    ship = _ship()
+    small = turning_circle(make_model("vmm", ship), 35.0)
+    big = turning_circle(make_model("vmm", ship.scaled(320.0 / 7.0)), 35.0)
+    assert big.tactical_diameter / 320.0 == pytest.approx(small.tactical_diameter / 7.0, rel=2e-3)
+    assert big.advance / 320.0 == pytest.approx(small.advance / 7.0, rel=2e-3)
+
+
+def test_a_uniform_current_carries_the_ship_without_changing_its_motion_in_the_water() -> None:
+    ship = _ship()
+    model = make_model("vmm", ship)
+    x0 = [0.0, 0.0, 0.0, ship.approach_speed, 0.0, 0.0, 0.0]
+    inputs = np.tile([math.radians(20.0), ship.approach_thrust(), 0.0, 0.0], (400, 1))
+    calm = model.simulate(x0, inputs, 0.1)
+    c = np.array([0.1, -0.05])
+    x0c = np.array(x0)
+    x0c[3:5] += c  # the same water-relative start (heading 0: body = earth axes)
+    drift = model.simulate(x0c, inputs, 0.1, current=c)
+    np.testing.assert_allclose(drift["psi"], calm["psi"], atol=1e-10)
+    np.testing.assert_allclose(drift["x"] - calm["x"], c[0] * calm.time, atol=1e-8)
+    np.testing.assert_allclose(drift["y"] - calm["y"], c[1] * calm.time, atol=1e-8)
+
+
+def test_clarke_added_masses_of_the_kvlcc2_have_the_published_size() -> None:
+    a = clarke_added_masses(7.0, 1.2688, 0.455, 0.81)
+    # Yasukawa and Yoshimura (2015): m_y' 0.223 on rho/2 L^2 d, i.e. 0.0145 on rho/2 L^3
+    assert -a["Y_vdot"] == pytest.approx(0.223 * 0.455 / 7.0, rel=0.15)
+    assert all(v < 0 for v in a.values())
+
+
+def test_model_file_round_trip_and_errors(tmp_path: Path) -> None:
+    ship = _ship()
+    path = tmp_path / "ship.json"
+    path.write_text(json.dumps(ship.to_dict()))
+    back = VMMParams.load(path)
+    assert back.coefficients == ship.coefficients and back.mass == ship.mass
+    with pytest.raises(ValueError, match="VMMParams or the path"):
+        make_model("vmm")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{")
+    with pytest.raises(ValueError, match="cannot read a VMM"):
+        make_model("vmm", str(bad))
+    with pytest.raises(ValueError, match="keys"):
+        VMMParams.from_dict({"coefficients": {}})
+
+
+# ------------------------------------------------------------------------------------------
+# identification against a known ship
+
+
+@pytest.fixture(scope="module")
+def wind_runs() -> list:
+    return generate_vmm_runs("wind", n_runs=6, seed=1)
+
+
+@pytest.fixture(scope="module")
+def wind_fit(wind_runs: list):
+    return identify(wind_runs, "vmm:linear", max_effects=2)
+
+
+def test_noise_free_regression_returns_the_true_coefficients() -> None:
+    runs = generate_vmm_runs(None, n_runs=4, seed=3, noise=False)
+    truth = runs[0].meta["truth"]["coefficients"]
+    template = vessel_params(runs[0])
+    reg = regress(prepare_runs(runs, template), template, list(truth))
+    for name, value in truth.items():
+        assert reg.coefficients[name] == pytest.approx(value, abs=0.02 * abs(value) + 1e-4), name
+    assert reg.r2["Y"] > 0.999 and reg.r2["N"] > 0.999
+
+
+def test_collinear_terms_are_reported_and_left_out() -> None:
+    runs = generate_vmm_runs(None, n_runs=2, seed=0)
+    template = vessel_params(runs[0])
+    # the same monomial under two names
+    terms = [*TERM_SETS["linear"], "Y_vr", "Y_rv"]
+    reg = regress(prepare_runs(runs, template), template, terms)
+    dropped = set(reg.collinear)
+    assert len(dropped & {"Y_vr", "Y_rv"}) == 1
+    (name,) = dropped & {"Y_vr", "Y_rv"}
+    assert reg.collinear[name][0] in {"Y_vr", "Y_rv"} - {name}
+    assert all(1.0 < c < 1.0 / 1e-3 for c in reg.condition.values())  # what is kept is sound
+    for name in dropped:
+        assert reg.coefficients[name] == 0.0 and math.isnan(reg.stderr[name])
+        assert reg.collinear[name]  # the terms it follows are named
+
+
+def test_the_undeclared_wind_is_named_and_the_coefficients_come_back(wind_fit, wind_runs) -> None:
+    assert wind_fit.effect_names[:1] == ["wind"]
+    truth = wind_runs[0].meta["truth"]["coefficients"]
+    se = wind_fit.diagnostics["final"]["stderr"]
+    for name, value in truth.items():
+        z = (wind_fit.parameters_after[name] - value) / se[name]
+        assert abs(z) < 3.0, (name, z)
+    held = wind_fit.heldout
+    assert held["error_after"]["psi_rms_deg"] < 0.3 * held["error_before"]["psi_rms_deg"]
+
+
+def test_a_clean_ship_gets_no_effect() -> None:
+    runs = generate_vmm_runs(None, n_runs=6, seed=2)
+    result = identify(runs, "vmm:linear", max_effects=2)
+    assert result.effect_names == []
+    truth = runs[0].meta["truth"]["coefficients"]
+    se = result.diagnostics["final"]["stderr"]
+    for name, value in truth.items():
+        assert abs(result.parameters_after[name] - value) < 3.0 * se[name], name
+
+
+def test_the_rudder_slipstream_is_named() -> None:
+    runs = generate_vmm_runs("rudder_slipstream", n_runs=6, seed=0)
+    result = identify(runs, "vmm:linear", max_effects=1)
+    assert result.effect_names == ["rudder_slipstream"]
+    truth = runs[0].meta["truth"]["effect_parameters"]
+    for name, value in truth.items():
+        assert result.parameters_after[name] == pytest.approx(value, rel=0.15)
+
+
+def test_single_run_families_refuse_several_records(wind_runs) -> None:
+    with pytest.raises(ValueError, match="one record at a time"):
+        identify(wind_runs[:2], "nomoto1")
+
+
+def test_a_record_of_an_unknown_ship_asks_for_particulars() -> None:
+    from shipgym.sysid import generate_record
+
+    rec = generate_record(None, base_model="rvg3dof", duration=200.0)
+    with pytest.raises(ValueError, match="particulars"):
+        identify([rec, rec], "vmm:linear")
+
+
+# ------------------------------------------------------------------------------------------
+# the measured KVLCC2
+
+
+@pytest.mark.skipif(not HSVA, reason="measured HSVA records not present")
+def test_hsva_inverse_dynamics_explain_the_side_force_and_moment() -> None:
+    recs = [load(p) for p in HSVA]
+    template = vessel_params(recs[0])
+    runs = prepare_runs(recs, template)
+    reg = regress(runs, template, TERM_SETS["martin"])
+    assert reg.r2["Y"] > 0.97 and reg.r2["N"] > 0.98
+    # course-keeping physics: the rudder turns the ship to starboard, yaw is damped
+    assert reg.coefficients["N_d"] > 0 and reg.coefficients["Y_d"] < 0
+    assert reg.coefficients["X_T"] == pytest.approx(1.0 - 0.22, abs=0.15)  # 1 - t_P (MMG)
+
+
+# ------------------------------------------------------------------------------------------
+# CLI: several runs in, a model file out, the model in the manoeuvres
+
+
+def test_cli_identifies_several_runs_and_simulates_the_fitted_model(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    runs = generate_vmm_runs("rudder_slipstream", n_runs=4, seed=5)
+    paths = []
+    for k, rec in enumerate(runs):
+        paths.append(tmp_path / f"run{k}.csv")
+        rec.to_csv(paths[-1])
+    fit = tmp_path / "fit.json"
+    code = main(["identify", *map(str, paths), "--model", "vmm:linear", "--json", str(fit),
+                 "--quiet", "--max-effects", "1"])  # fmt: skip
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "error of the final model per run" in out and "std. error" in out
+    doc = json.loads(fit.read_text())
+    assert doc["model"] == "vmm:linear" and "Y_Td" in doc["vmm"]["coefficients"]
+    ship = VMMParams.load(fit)
+    result = zigzag(make_model("vmm", ship), 10.0)
+    assert 0.0 < result.overshoots[0] < 20.0
+    assert main(["simulate", "turning", "--model", "vmm", "--params", str(fit)]) == 0
+    assert "tactical diameter" in capsys.readouterr().out
+
+
+def test_cli_refuses_to_overwrite_an_input(tmp_path: Path) -> None:
+    runs = generate_vmm_runs(None, n_runs=2, seed=0)
+    paths = [tmp_path / "a.csv", tmp_path / "b.csv"]
+    for rec, p in zip(runs, paths, strict=True):
+        rec.to_csv(p)
+    before = paths[1].read_bytes()
+    code = main(["identify", *map(str, paths), "--model", "vmm:linear", "--json", str(paths[1])])
+    assert code == 2
+    assert paths[1].read_bytes() == before
+    assert main(["simulate", "zigzag", "--model", "vmm"]) == 2
