@@ -4,10 +4,12 @@ Usage::
 
     python scripts/identify_all.py [--root ../shared/data/measured] [--only SUBSTRING]
                                    [--out docs] [--readme README.md | --no-readme]
-                                   [--models nomoto1,rvg3dof] [--fresh] [--render-only] [-v]
+                                   [--models nomoto1,rvg3dof,vmm:martin_simple] [--fresh]
+                                   [--render-only] [-v]
 
 Runs :func:`shipgym.sysid.report.identify_all` (``nomoto1`` on every record, ``rvg3dof`` also on
-the Gunnerus sea trials) with a progress line per record on stderr, then writes
+the Gunnerus sea trials, the 3-DOF ``vmm:martin_simple`` on every KVLCC2 and Esso Osaka record,
+each run alone: fitted on its first 70 %) with a progress line per record on stderr, then writes
 
 * ``OUT/identification.json``: the rows (errors before/after, held-out errors, effects,
   parameters, runtimes; failures with their message);
@@ -64,7 +66,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--models",
         default=",".join(DEFAULT_MODELS),
-        help="comma-separated bases (rvg3dof runs only on records with pod channels)",
+        help="comma-separated bases (rvg3dof runs only on records with pod channels, vmm:... "
+        "only on records of a ship with known particulars)",
     )
     parser.add_argument("--holdout", type=float, default=0.3)
     parser.add_argument("--max-effects", type=int, default=3)

@@ -305,3 +305,18 @@ def test_cli_refuses_to_overwrite_an_input(tmp_path: Path) -> None:
     assert code == 2
     assert paths[1].read_bytes() == before
     assert main(["simulate", "zigzag", "--model", "vmm"]) == 2
+
+
+def test_identify_all_adds_a_3dof_row_for_records_of_a_known_ship() -> None:
+    from shipgym.sysid.report import identify_all, model_applies
+
+    run = generate_vmm_runs("current", n_runs=2, seed=4)[1]  # a 20/20 zigzag in a current
+    assert model_applies("vmm:linear", run)
+    nomoto_only = replace(run, meta={k: v for k, v in run.meta.items() if k != "particulars"})
+    assert not model_applies("vmm:linear", nomoto_only)
+    rows = identify_all(records=[run], models=("vmm:linear",), progress=False, max_effects=1)
+    (row,) = rows
+    assert row["status"] == "ok", row.get("message")
+    # one run alone: fitted on its first 70 %, the rest predicted
+    assert row["heldout"]["runs"] and row["error_after"]["psi_rms_deg"] < 10.0
+    assert "X_T" in row["parameters_after"]

@@ -73,9 +73,11 @@ __all__ = [
     "write_json",
 ]
 
-DEFAULT_MODELS: tuple[str, ...] = ("nomoto1", "rvg3dof")
-"""Bases run by :func:`identify_all` by default: ``nomoto1`` on every record, ``rvg3dof`` on the
-records it applies to (:func:`model_applies`)."""
+DEFAULT_MODELS: tuple[str, ...] = ("nomoto1", "rvg3dof", "vmm:martin_simple")
+"""Bases run by :func:`identify_all` by default: ``nomoto1`` on every record, ``rvg3dof`` and
+the 3-DOF ``vmm:martin_simple`` on the records they apply to (:func:`model_applies`)."""
+
+_VMM_SOURCES = ("hsva", "marin", "esso_osaka")
 
 FIGURES: dict[str, tuple[str, str]] = {
     "sspa": ("nomoto1", "identification_sspa.png"),
@@ -173,10 +175,17 @@ def model_applies(model: str, record: Record) -> bool:
     """Whether :func:`identify_all` runs ``model`` on ``record``.
 
     ``rvg3dof`` needs the pod channels (``azimuth``, ``rpm``), positions and body velocities
-    (the Gunnerus sea trials and generated RVG records); every other base applies to all records.
+    (the Gunnerus sea trials and generated RVG records); the 3-DOF ``vmm:...`` models need
+    positions, body velocities, thrust or rpm and a ship whose particulars are known (the
+    KVLCC2 and Esso Osaka records, or ``meta["particulars"]``); every other base applies to all
+    records.
     """
     if model == "rvg3dof":
         return all(getattr(record, ch) is not None for ch in ("azimuth", "rpm", "x", "y", "u"))
+    if model.startswith("vmm:"):
+        known = record.meta.get("source") in _VMM_SOURCES or "particulars" in record.meta
+        motion = all(getattr(record, ch) is not None for ch in ("x", "y", "u", "v"))
+        return known and motion and (record.thrust is not None or record.rpm is not None)
     return True
 
 

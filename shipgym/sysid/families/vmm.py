@@ -1063,12 +1063,21 @@ class VMMFamily(ModelFamily):
     ) -> dict[str, Any]:
         everything = list(range(len(ctx.runs)))
         say("fits of the base and final models on every run")
-        base_full = self._refit_all(ctx, base)
-        final_full = self._refit_all(ctx, final) if final.effects else base_full
-        sims = {
-            "before": predict(base_full, ctx.rp, everything),
-            "after": predict(final_full, ctx.rp, everything),
-        }
+        notes = []
+        fits, sims = {}, {}
+        for key, cand in (("before", base), ("after", final)):
+            fit = self._refit_all(ctx, cand) if key == "before" or final.effects else fits[
+                "before"]  # fmt: skip
+            sim = predict(fit, ctx.rp, everything)
+            if not np.all(np.isfinite(sim)):  # e.g. one poorly excited run: keep the training fit
+                notes.append(f"the {key} model refitted on every run diverges; the fit on the "
+                             "training runs is reported")  # fmt: skip
+                fit = cand.fitted
+                sim = predict(fit, ctx.rp, everything)
+            fits[key], sims[key] = fit, sim
+        base_full, final_full = fits["before"], fits["after"]
+        for note in notes:
+            say(note)
         every = ctx.rp.run_mask(everything)
         held_mask = ctx.rp.run_mask(ctx.held)
         held_sims = {
@@ -1114,6 +1123,7 @@ class VMMFamily(ModelFamily):
                     "r2": reg.r2,
                     "refined": final_full.refined,
                     "per_run": per_run,
+                    "notes": notes,
                 },
                 "base": {"stderr": base_full.stderr, "collinear": base_full.regression.collinear},
             },
