@@ -9,7 +9,9 @@ Usage::
 Times (median after a warm-up for Numba, see :func:`shipgym.sysid.report.benchmark_sysid`) a
 ``nomoto1`` output-error fit of 10 001 generated samples (goal 1 s), the whole identification
 loop on a 10 001-sample generated record with one effect (goal 10 s) and ``identify`` with base
-``rvg3dof`` on the Gunnerus sea trials (goal 60 s; skipped with a message while unavailable).
+``rvg3dof`` on the Gunnerus sea trials (goal 60 s; skipped with a message while unavailable),
+and the 3-DOF ``vmm:martin_simple`` on the 13 HSVA KVLCC2 runs together (regression goal 5 s,
+whole loop goal 60 s).
 Prints each time with its goal and ratio, writes ``OUT/bench_sysid.json`` and
 ``OUT/bench_sysid.png`` and, when the README has them, refreshes the block between
 ``<!-- bench_sysid -->`` and ``<!-- /bench_sysid -->``. The exit code does not depend on the
@@ -42,6 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--effect", default="rudder_lag", help="effect of the loop record")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-gunnerus", action="store_true", help="skip the Gunnerus record")
+    parser.add_argument("--no-kvlcc2", action="store_true", help="skip the HSVA KVLCC2 runs")
     parser.add_argument("--out", default=str(REPO / "docs"), help="output folder")
     parser.add_argument("--readme", default=str(REPO / "README.md"))
     parser.add_argument("--no-readme", action="store_true", help="do not touch the README")
@@ -53,6 +56,7 @@ def main(argv: list[str] | None = None) -> int:
         effect=args.effect,
         seed=args.seed,
         gunnerus=not args.no_gunnerus,
+        kvlcc2=not args.no_kvlcc2,
         progress=sys.stderr,
     )
     table = format_benchmark(report)

@@ -410,7 +410,8 @@ def test_benchmark_table_and_plot(tmp_path: Path) -> None:
 def test_benchmark_sysid_smoke() -> None:
     lines: list[str] = []
     rep = benchmark_sysid(None, repeats=1, duration=20.0, progress=lines.append)
-    fit, loop, gunnerus = rep["results"]
+    fit, loop, gunnerus, hsva_regression, hsva_loop = rep["results"]
+    assert hsva_regression["skipped"] == hsva_loop["skipped"] == "HSVA records not found (None)"
     assert (fit["name"], fit["samples"], len(fit["times_s"])) == ("fit", 201, 3)
     assert loop["samples"] == 201 and loop["details"]["effect"] == "rudder_lag"
     for r in (fit, loop):

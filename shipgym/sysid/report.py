@@ -88,9 +88,19 @@ FIGURES: dict[str, tuple[str, str]] = {
 README_MARKER = "identification"
 """Name of the README block: ``<!-- identification -->`` ... ``<!-- /identification -->``."""
 
-BENCH_GOALS: dict[str, float] = {"fit": 1.0, "loop": 10.0, "gunnerus": 60.0}
+BENCH_GOALS: dict[str, float] = {
+    "fit": 1.0,
+    "loop": 10.0,
+    "gunnerus": 60.0,
+    "hsva_regression": 5.0,
+    "hsva_loop": 60.0,
+}
 """Speed goals [s]: nomoto1 output-error fit of 10 000 samples, the whole loop on a
-10 000-sample record, the Gunnerus record with ``rvg3dof``."""
+10 000-sample record, the Gunnerus record with ``rvg3dof``, and the 3-DOF model on all 13 HSVA
+KVLCC2 runs together (the inverse-dynamics regression, and the whole loop)."""
+
+BENCH_VMM = "vmm:martin_simple"
+"""The 3-DOF model the HSVA benchmark identifies."""
 
 _SOURCE_ORDER = ("sspa", "marin", "hsva", "esso_osaka", "usv", "gunnerus")
 _SOURCE_LABEL = {
@@ -986,6 +996,7 @@ def benchmark_sysid(
     seed: int = 0,
     duration: float = 1000.0,
     gunnerus: bool = True,
+    kvlcc2: bool = True,
     progress: ProgressArg = True,
 ) -> dict[str, Any]:
     """Time the identification against its speed goals (:data:`BENCH_GOALS`).
@@ -996,7 +1007,10 @@ def benchmark_sysid(
       zigzag with the effect ``effect``; median of ``repeats``;
     * ``gunnerus``: ``identify(record, "rvg3dof")`` on the Gunnerus sea trials under ``root``;
       one run (skipped with a reason when ``root`` is None, the file is missing or
-      :mod:`shipgym.sysid.families.rvg` is not registered).
+      :mod:`shipgym.sysid.families.rvg` is not registered);
+    * ``hsva_regression``, ``hsva_loop`` (``kvlcc2``): the 3-DOF :data:`BENCH_VMM` on the 13
+      HSVA KVLCC2 runs under ``root`` together: the inverse-dynamics regression (loading and
+      filtering included; median of ``repeats``) and the whole identification loop (one run).
 
     ``duration`` [s] sets the length of the generated records (1000 s: 10 001 samples; shorter
     only for smoke tests). Each is preceded by an untimed warm-up on a short record (Numba
@@ -1109,6 +1123,22 @@ def benchmark_sysid(
         except Exception as exc:
             add("gunnerus", desc, rec.n, [], skipped=f"failed: {type(exc).__name__}: {exc}")
 
+    # 4. the 3-DOF model on the 13 HSVA runs together
+    folder = None if root is None else Path(root) / "hsva_kvlcc2"
+    descs = {
+        "hsva_regression": f"{BENCH_VMM} regression, 13 HSVA KVLCC2 runs",
+        "hsva_loop": f"identify loop, {BENCH_VMM}, 13 HSVA KVLCC2 runs",
+    }
+    if not kvlcc2:
+        for name, desc in descs.items():
+            add(name, desc, None, [], skipped="not requested")
+    elif folder is None or not sorted(folder.glob("*.dat")):
+        for name, desc in descs.items():
+            add(name, desc, None, [], skipped=f"HSVA records not found ({folder})")
+    else:
+        for name, n, times, details in _bench_hsva(folder, repeats, say):
+            add(name, descs[name], n, times, **details)
+
     return {
         "config": {
             "repeats": repeats,
@@ -1122,6 +1152,32 @@ def benchmark_sysid(
         "system": _system(time.perf_counter() - t_start),
         "results": results,
     }
+
+
+def _bench_hsva(
+    folder: Path, repeats: int, say: Callable[[str], None]
+) -> list[tuple[str, int, list[float], dict[str, Any]]]:
+    """The HSVA timings of :func:`benchmark_sysid`: ``(name, samples, times, details)``."""
+    from shipgym.models.vmm import TERM_SETS
+    from shipgym.sysid.families import vmm as fv
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        hsva = [load(p, "hsva") for p in sorted(folder.glob("*.dat"))]
+    n = sum(r.n for r in hsva)
+    template = fv.vessel_params(hsva[0])
+    terms = TERM_SETS[BENCH_VMM.removeprefix("vmm:")]
+    say("hsva: warm-up on two runs ...")
+    identify(hsva[:2], BENCH_VMM, max_effects=0)
+    reg_times, _ = _median_time(
+        lambda: fv.regress(fv.prepare_runs(hsva, template), template, terms), max(repeats, 3)
+    )
+    say(f"hsva_loop: identify {BENCH_VMM} on {n} samples (one run) ...")
+    loop_times, res = _median_time(lambda: identify(hsva, BENCH_VMM), 1)
+    return [
+        ("hsva_regression", n, reg_times, {}),
+        ("hsva_loop", n, loop_times, {"effects_found": res.effect_names}),
+    ]
 
 
 def _system(elapsed: float) -> dict[str, Any]:
