@@ -48,9 +48,12 @@ from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
 from shipgym.models._jit import kernel, row_kernel
+from shipgym.models.base import make_model
 from shipgym.models.integrate import rk4_stages
 from shipgym.models.mmg import KVLCC2_SCALE, MMGParams
 from shipgym.models.vmm import (
+    P_INV,
+    P_MU,
     TERM_SETS,
     VMMParams,
     clarke_added_masses,
@@ -330,8 +333,8 @@ def _monomials(terms: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 def _factors(
     run: _Run, params: VMMParams, current: Sequence[float]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Prime factors ``(n, 11)``, ``U``, and the relative velocities ``u_r, v_r``."""
+) -> tuple[np.ndarray, np.ndarray]:
+    """Prime factors ``(n, 11)`` of the terms and the speed through the water ``U``."""
     psi = run.states[:, 2]
     cs, sn = np.cos(psi), np.sin(psi)
     uc = current[0] * cs + current[1] * sn
@@ -349,34 +352,26 @@ def _factors(
         ur / big_u, vp, rp, d, run.thrust / (0.5 * params.rho * params.length**2 * u2),
         np.abs(vp), np.abs(rp), np.abs(d), w2 * np.cos(g), w2 * np.sin(g), w2 * np.sin(2 * g),
     ))  # fmt: skip
-    return f, big_u, ur, vr
+    return f, big_u
 
 
-def _forces(
-    run: _Run, params: VMMParams, current: Sequence[float], ur: np.ndarray, vr: np.ndarray
-) -> np.ndarray:
-    """``(n, 3)`` hydrodynamic forces ``X_D, Y_D, N_D`` by inverse dynamics (the motion
-    equations of :func:`~shipgym.models.vmm.vmm_row` solved for the forces)."""
-    p = pack_vmm(replace(params, coefficients={}))
-    from shipgym.models import vmm as v
-
-    r = run.states[:, 5]
-    psi = run.states[:, 2]
-    uc = current[0] * np.cos(psi) + current[1] * np.sin(psi)
-    vc = -current[0] * np.sin(psi) + current[1] * np.cos(psi)
-    dur = run.accel[:, 0] - r * vc  # relative accelerations (constant current)
-    dvr = run.accel[:, 1] + r * uc
-    dr = run.accel[:, 2]
-    m, mxg, xud = p[v.P_M], p[v.P_MXG], p[v.P_XUD]
-    lin = p[v.P_YVD] * vr + p[v.P_YRD] * r
-    minv = p[v.P_INV : v.P_INV + 4].reshape(2, 2)
-    mat = np.linalg.inv(minv)
-    fx = p[v.P_MU] * dur - (m * vr * r + mxg * r * r - lin * r)
-    by = mat[0, 0] * dvr + mat[0, 1] * dr
-    bn = mat[1, 0] * dvr + mat[1, 1] * dr
-    fy = by - (-m * ur * r + xud * ur * r)
-    fn = bn - (-mxg * ur * r + lin * ur - xud * ur * vr)
-    return np.column_stack((fx, fy, fn))
+def _forces(run: _Run, params: VMMParams, current: Sequence[float]) -> np.ndarray:
+    """``(n, 3)`` hydrodynamic forces ``X_D, Y_D, N_D`` by inverse dynamics: the model's own
+    derivative (:func:`~shipgym.models.vmm.vmm_row`) without hydrodynamic terms gives the
+    accelerations of the rigid-body and added-mass terms; the measured accelerations' excess,
+    times the mass matrix, is the hydrodynamic force."""
+    bare = replace(params, coefficients={}, direct_rudder=True)
+    n = run.t.size
+    x = np.column_stack((run.states, np.zeros(n)))
+    inputs = np.zeros((n, 4))
+    c = np.tile(np.asarray(current, dtype=np.float64), (n, 1))
+    a0 = make_model("vmm", bare).deriv(x, inputs, c)[:, 3:6]
+    excess = run.accel - a0
+    p = pack_vmm(bare)
+    mass = np.zeros((3, 3))
+    mass[0, 0] = p[P_MU]
+    mass[1:, 1:] = np.linalg.inv(p[P_INV : P_INV + 4].reshape(2, 2))
+    return excess @ mass.T
 
 
 @dataclass
@@ -457,8 +452,8 @@ def regress(
     rows_f, rows_y, segments, lags = [], [], [], []
     start = 0
     for run in runs:
-        f, big_u, ur, vr = _factors(run, params, current)
-        forces = _forces(run, params, current, ur, vr)
+        f, big_u = _factors(run, params, current)
+        forces = _forces(run, params, current)
         q = 0.5 * params.rho * params.length**2 * big_u**2
         prime = forces / np.column_stack((q, q, q * params.length))
         rows_f.append(f)
