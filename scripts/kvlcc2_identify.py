@@ -170,7 +170,9 @@ def _nomoto_fit(score: Any, runs: list[Any], which: list[int], theta: np.ndarray
     x0 = np.concatenate(([0.05, 20.0, 0.0] if theta is None else [], np.zeros(len(wins))))
     scale = np.concatenate(([0.05, 10.0, 0.01] if theta is None else [],
                             np.full(len(wins), r_scale)))  # fmt: skip
-    sol = least_squares(resid, x0, x_scale=scale, jac_sparsity=sp, max_nfev=60)
+    # (scipy's trust region with a sparse Jacobian needs at least three unknowns)
+    sol = least_squares(resid, x0, x_scale=scale, jac_sparsity=sp if x0.size > 2 else None,
+                        max_nfev=60)  # fmt: skip
     th = theta if theta is not None else sol.x[:3]
     e = resid(sol.x)[: n_res - len(wins)]
     psi_e, r_e = [], []
@@ -240,6 +242,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
     ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument("--folds", help="JSON file keeping the VMM fold results between runs")
     args = ap.parse_args(argv)
     root, out = Path(args.root), Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -255,12 +258,17 @@ def main(argv: list[str] | None = None) -> int:
     vmm_tasks = [(str(root), "hsva_kvlcc2", i, "*.dat", ts, None)
                  for ts in TERM_SETS for i in range(n_h)]  # fmt: skip
     nom_tasks = [(str(root), "hsva_kvlcc2", i, "*.dat") for i in range(n_h)]
+    cache = Path(args.folds) if args.folds else None
+    vmm_rows = json.loads(cache.read_text()) if cache and cache.exists() else []
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        vmm_rows = []
-        for k, row in enumerate(pool.map(_vmm_fold, vmm_tasks)):
-            vmm_rows.append(row)
-            _say(f"  {k + 1}/{len(vmm_tasks)} {row['term_set']} {row['run']}: "
-                 f"psi {row['psi_rms_deg']:.2f} deg")  # fmt: skip
+        if len(vmm_rows) != len(vmm_tasks):
+            vmm_rows = []
+            for k, row in enumerate(pool.map(_vmm_fold, vmm_tasks)):
+                vmm_rows.append(row)
+                _say(f"  {k + 1}/{len(vmm_tasks)} {row['term_set']} {row['run']}: "
+                     f"psi {row['psi_rms_deg']:.2f} deg")  # fmt: skip
+            if cache:
+                cache.write_text(json.dumps(vmm_rows))
         nomoto_rows = list(pool.map(_nomoto_fold, nom_tasks))
     cv_s = time.perf_counter() - t0
     median = {ts: float(np.median([r["psi_rms_deg"] for r in vmm_rows if r["term_set"] == ts]))

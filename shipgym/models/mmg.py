@@ -62,7 +62,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from shipgym.models._jit import kernel, row_kernel
-from shipgym.models.kinematics import body_current, planar_kinematics
+from shipgym.models.kinematics import relative_motion, steering_gear
 
 MMG_STATES = ("x", "y", "psi", "u", "v", "r", "delta")
 MMG_INPUTS = ("delta_c", "n")
@@ -350,18 +350,10 @@ def pack_mmg(params: MMGParams) -> np.ndarray:
 @row_kernel
 def mmg_row(x, u, p, c, out):
     """MMG standard model derivative (Yasukawa and Yoshimura 2015 eq. 4-46)."""
-    psi = x[IPSI]
-    cs = math.cos(psi)
-    sn = math.sin(psi)
-    ug = x[IU]
-    vg = x[IV]
     r = x[IR]
     delta = x[IDELTA]
-    planar_kinematics(ug, vg, r, cs, sn, out)
     # velocities relative to the water
-    uc, vc = body_current(c, cs, sn)
-    ur = ug - uc
-    vr = vg - vc
+    ur, vr, uc, vc = relative_motion(x, c, out)
     # U and beta at midship (the paper) or, with ShipMMG's formulas, at the centre of gravity
     vb = vr - p[P_XG_BETA] * r
     big_u = math.sqrt(ur * ur + vb * vb)
@@ -429,11 +421,7 @@ def mmg_row(x, u, p, c, out):
     out[IU] = bx / p[P_MU] + r * vc
     out[IV] = p[P_INV] * by + p[P_INV + 1] * bn - r * uc
     out[IR] = p[P_INV + 2] * by + p[P_INV + 3] * bn
-    # steering gear
-    dmax = p[P_GEAR]
-    dc = min(max(u[0], -dmax), dmax)
-    rate = p[P_GEAR + 1]
-    out[IDELTA] = min(max((dc - delta) * p[P_GEAR + 2], -rate), rate)
+    out[IDELTA] = steering_gear(delta, u[0], p[P_GEAR], p[P_GEAR + 1], p[P_GEAR + 2])
 
 
 @kernel

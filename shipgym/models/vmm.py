@@ -71,7 +71,7 @@ from typing import Any
 import numpy as np
 
 from shipgym.models._jit import row_kernel
-from shipgym.models.kinematics import body_current, planar_kinematics
+from shipgym.models.kinematics import relative_motion, steering_gear
 
 __all__ = [
     "FACTORS",
@@ -449,24 +449,15 @@ def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
 @row_kernel
 def vmm_row(x, u, p, c, out):
     """State derivative of the VMM (module docstring; seed 003 ``eq_system``)."""
-    psi = x[IPSI]
-    cs = math.cos(psi)
-    sn = math.sin(psi)
-    ug = x[IU]
-    vg = x[IV]
+    ur, vr, uc, vc = relative_motion(x, c, out)
     r = x[IR]
-    planar_kinematics(ug, vg, r, cs, sn, out)
-    uc, vc = body_current(c, cs, sn)
-    ur = ug - uc
-    vr = vg - vc
     g = P_GEAR
     if p[g + 3] != 0.0:
         delta = u[0]
         out[IDELTA] = 0.0
     else:
         delta = x[IDELTA]
-        dc = min(max(u[0], -p[g]), p[g])
-        out[IDELTA] = min(max((dc - delta) * p[g + 2], -p[g + 1]), p[g + 1])
+        out[IDELTA] = steering_gear(delta, u[0], p[g], p[g + 1], p[g + 2])
     fx, fy, fn = vmm_forces(ur, vr, r, delta + p[P_OFFSET], u[1], u[2], u[3], p)
     m = p[P_M]
     mxg = p[P_MXG]

@@ -788,9 +788,11 @@ def _fit_windows(
 
     th0 = np.concatenate((theta0, np.zeros(2 * len(windows))))
     r0 = resid(th0)
+    # (scipy's trust region with a sparse Jacobian needs at least three unknowns)
     sol = least_squares(
         resid, th0, x_scale=np.concatenate((theta_scale, np.tile(start_scale, len(windows)))),
-        method="trf", max_nfev=max_nfev, jac_sparsity=sparsity, xtol=1e-6, ftol=1e-6,
+        method="trf", max_nfev=max_nfev, jac_sparsity=sparsity if th0.size > 2 else None,
+        xtol=1e-6, ftol=1e-6,
     )  # fmt: skip
     return sol.x[:n_c], starts(sol.x), 0.5 * float(r0 @ r0), float(sol.cost)
 
