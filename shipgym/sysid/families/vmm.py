@@ -1073,6 +1073,13 @@ class VMMFamily(ModelFamily):
                 sim = predict(fit, ctx.rp, everything)
             fits[key], sims[key] = fit, sim
         base_full, final_full = fits["before"], fits["after"]
+        if not np.all(np.isfinite(sims["after"])):
+            raise ValueError(
+                "not identifiable from these records: the fitted model diverges when they are "
+                f"replayed ({sum(r.t.size for r in ctx.runs)} samples for "
+                f"{len(final_full.params.coefficients)} terms); fit several runs of the ship "
+                "together (zigzags and turns), or a smaller term set"
+            )
         for note in notes:
             say(note)
         every = ctx.rp.run_mask(everything)
