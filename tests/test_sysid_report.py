@@ -428,8 +428,11 @@ MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "mea
 @pytest.mark.skipif(not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}")
 def test_identify_all_reads_the_measured_root() -> None:
     rows = identify_all(MEASURED, only="esso_osaka/zigzag_31-Jul-2020_13_57", max_effects=0)
-    assert len(rows) == 1
-    (row,) = rows
+    # nomoto1 on every record, the 3-DOF model on a ship whose particulars are known
+    assert [r["model"] for r in rows] == ["nomoto1", "vmm:martin_simple"]
+    row, row3 = rows
+    assert row3["status"] == "ok", row3.get("message")
+    assert "X_T" in row3["parameters_after"]
     assert row["status"] == "ok", row.get("message")
     assert row["label"] == "Esso Osaka zigzag_31-Jul-2020_13_57_45"
     assert row["manoeuvre"] == "zigzag"
