@@ -201,8 +201,10 @@ def _nomoto_fold(task: tuple[str, str, int, str]) -> dict[str, Any]:
 # trials of a fitted model
 
 
-def _trials_of(fit: Any, records: list[Any], simman: dict[str, Any]) -> list[dict[str, Any]]:
-    ship = make_model("vmm", fit.params)
+def _trials_of(
+    fit: Any, mmg: Any, records: list[Any], simman: dict[str, Any]
+) -> list[dict[str, Any]]:
+    ships = {"vmm": make_model("vmm", fit.params), "mmg_refined": make_model("kvlcc2", mmg.params)}
     rows = []
     for rec in records:
         trial = _trial(Path(rec.meta["file"]))
@@ -211,18 +213,19 @@ def _trials_of(fit: Any, records: list[Any], simman: dict[str, Any]) -> list[dic
         ref = simman.get(rec.meta["file"], {})
         row = {"record": rec.meta["file"], **trial, "measured": ref.get("measured"),
                "mmg": ref.get("model")}  # fmt: skip
-        try:
-            if trial["kind"] == "zigzag":
-                z = maneuvers.zigzag(ship, trial["a"], trial["b"], first=trial["side"] or
-                                     "starboard")  # fmt: skip
-                row["vmm"] = {"overshoot1_deg": z.overshoots_deg[0],
-                              "overshoot2_deg": z.overshoots_deg[1]}  # fmt: skip
-            else:
-                tc = maneuvers.turning_circle(ship, trial["a"], trial["side"])
-                row["vmm"] = {"advance": tc.advance, "tactical_diameter": tc.tactical_diameter,
-                              "speed_ratio": tc.speed_ratio}  # fmt: skip
-        except (ValueError, IndexError) as exc:
-            row["vmm"] = {"error": str(exc)}
+        for key, ship in ships.items():
+            try:
+                if trial["kind"] == "zigzag":
+                    z = maneuvers.zigzag(ship, trial["a"], trial["b"],
+                                         first=trial["side"] or "starboard")  # fmt: skip
+                    row[key] = {"overshoot1_deg": z.overshoots_deg[0],
+                                "overshoot2_deg": z.overshoots_deg[1]}  # fmt: skip
+                else:
+                    tc = maneuvers.turning_circle(ship, trial["a"], trial["side"])
+                    row[key] = {"advance": tc.advance, "tactical_diameter": tc.tactical_diameter,
+                                "speed_ratio": tc.speed_ratio}  # fmt: skip
+            except (ValueError, IndexError) as exc:
+                row[key] = {"error": str(exc)}
         rows.append(row)
     return rows
 
@@ -321,9 +324,14 @@ def main(argv: list[str] | None = None) -> int:
             f"TD {tc.tactical_diameter:.0f} m (measured {meas.get('tactical_diameter', 0):.0f})"
         )
 
+    _say("the MMG model refined on every run of each facility ...")
+    mmg = {name: identify(recs, "kvlcc2", max_effects=0).final
+           for name, recs in (("hsva", hsva), ("marin", marin))}  # fmt: skip
+    for name, fit in mmg.items():
+        _say(f"  {name}: factors {fit.factors}; at a bound: {fit.at_bound or 'none'}")
     _say("trial quantities of the models fitted on every run ...")
-    trials = _trials_of(_fit_all(hsva, best), hsva, simman) + _trials_of(
-        _fit_all(marin, best), marin, simman
+    trials = _trials_of(_fit_all(hsva, best), mmg["hsva"], hsva, simman) + _trials_of(
+        _fit_all(marin, best), mmg["marin"], marin, simman
     )
 
     _say("Esso Osaka: the loop on the 15 pond runs ...")
@@ -348,6 +356,10 @@ def main(argv: list[str] | None = None) -> int:
         "loop_s": loop_s,
         "loop_effects": loop.effect_names,
         "marin": marin_rows,
+        "mmg_refined": {
+            name: {"factors": fit.factors, "stderr": fit.stderr, "at_bound": fit.at_bound}
+            for name, fit in mmg.items()
+        },
         "trials": trials,
         "esso": esso_summary,
         "runtime_s": time.perf_counter() - t0,
@@ -416,6 +428,32 @@ def render(doc: dict[str, Any]) -> str:
             f"facility) misses them by a median {np.median(under_vmm):+.1f} deg "
             f"(|max| {np.max(np.abs(under_vmm)):.1f}).",
         ]
+    mm = doc["mmg_refined"]
+    if mm:
+        zz_r = [t for t in zz if "overshoot1_deg" in t.get("mmg_refined", {})]
+        under_r = [t["measured"]["overshoot1_deg"] - t["mmg_refined"]["overshoot1_deg"]
+                   for t in zz_r]  # fmt: skip
+        names = list(next(iter(mm.values()))["factors"])
+        lines += [
+            "",
+            "The MMG model itself, its resistance and linear hull derivatives refined on the "
+            "same runs (`shipgym identify ... --model kvlcc2`; factors on the published values "
+            "with standard errors):",
+            "",
+            "| facility | " + " | ".join(f"`{k}`" for k in names) + " |",
+            "|---|" + "---:|" * len(names),
+        ]
+        for name, m in mm.items():
+            cells = [f"{m['factors'][k]:.2f} ± {m['stderr'][k]:.2f}" for k in names]
+            lines.append(f"| {name.upper()} | " + " | ".join(cells) + " |")
+        if zz_r:
+            bound = ", ".join(k for m in mm.values() for k in m["at_bound"]) or "none"
+            lines += [
+                "",
+                f"Refined this way the MMG model misses the first overshoots by a median "
+                f"{np.median(under_r):+.1f} deg (|max| {np.max(np.abs(under_r)):.1f}); factors "
+                f"at a bound: {bound}.",
+            ]
     e = doc["esso"]
     names = ", ".join(x["name"] for x in e["effects"]) or "none"
     lines += ["", f"Esso Osaka (15 pond runs with measured wind): effects named: {names}."]
@@ -445,6 +483,8 @@ def plot(doc: dict[str, Any], path: Path) -> None:
     ax.plot(meas, [t["mmg"]["overshoot1_deg"] for t in zz], "o", label="MMG, published")
     ax.plot(meas, [t["vmm"]["overshoot1_deg"] for t in zz], "s",
             label=f"VMM {doc['best_term_set']}, identified")  # fmt: skip
+    ax.plot(meas, [t.get("mmg_refined", {}).get("overshoot1_deg", np.nan) for t in zz], "^",
+            label="MMG, derivatives refined")  # fmt: skip
     lim = max([*meas, 1.0]) * 1.15
     ax.plot([0, lim], [0, lim], "k-", lw=0.8)
     ax.set_xlabel("measured first overshoot [deg]")

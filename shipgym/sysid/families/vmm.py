@@ -47,10 +47,10 @@ from scipy.linalg import qr
 from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
-from shipgym.models._jit import kernel, row_kernel
+from shipgym.models._jit import kernel
 from shipgym.models.base import make_model
-from shipgym.models.integrate import rk4_stages
-from shipgym.models.mmg import KVLCC2_SCALE, MMGParams
+from shipgym.models.integrate import KVLCC2, VMM, rk4_stages, row_rhs_all
+from shipgym.models.mmg import KVLCC2_SCALE, MMGParams, pack_mmg
 from shipgym.models.vmm import (
     P_INV,
     P_MU,
@@ -60,7 +60,6 @@ from shipgym.models.vmm import (
     pack_vmm,
     propeller_loading,
     term_matrix,
-    vmm_row,
 )
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
@@ -254,6 +253,7 @@ class _Run:
     wind: np.ndarray  # (n, 2) apparent wind speed, angle (zeros without wind channels)
     has_wind: bool
     measured: np.ndarray  # (n, 6) the record's own values
+    rps: np.ndarray  # propeller revolutions [1/s] (zeros without an rpm channel)
 
 
 def _cut(record: Record) -> Record:
@@ -311,9 +311,10 @@ def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
         wind = (
             np.column_stack((rec.wind_speed, rec.wind_angle)) if has_wind else np.zeros((rec.n, 2))
         )
-        runs.append(
-            _Run(name, rec.time, states, accel, rec.delta, np.asarray(thrust), wind, has_wind, meas)
-        )
+        rps = rec.rpm / 60.0 if rec.rpm is not None else np.zeros(rec.n)
+        run = _Run(name, rec.time, states, accel, rec.delta, np.asarray(thrust), wind, has_wind,
+                   meas, rps)  # fmt: skip
+        runs.append(run)
     return runs
 
 
@@ -517,26 +518,27 @@ def regress(
 # replay (simulation of runs from the measured states)
 
 
-@row_kernel
-def _vmm_deriv(model_id, x, u, p, c, out):  # pragma: no cover - jit
-    vmm_row(x, u, p, c, out)
-
-
 @kernel
-def _replay_kernel(t, starts, ends, x0, inputs, p, c, out):  # pragma: no cover - jit
+def _replay_kernel(model_id, t, starts, ends, x0, inputs, p, c, out):  # pragma: no cover - jit
     """Simulate windows ``[starts[w], ends[w])`` of concatenated samples, each from
-    ``x0[w]``, with the inputs of each step at its middle (direct rudder)."""
+    ``x0[w]``, with the inputs of each step at its middle and the rudder angle as measured
+    (the model's rudder state is set to it: the steering gear then holds it).
+
+    ``inputs`` columns: rudder, thrust input, apparent wind speed and angle, propeller
+    revolutions; the VMM reads the first four, the MMG model the rudder and the revolutions.
+    """
     x = np.empty((1, 7))
     u = np.empty((1, 4))
     cc = np.empty((1, 2))
     cc[0, 0] = c[0]
     cc[0, 1] = c[1]
     work = np.empty((5, 7))
+    mmg = model_id == KVLCC2
     for w in range(starts.shape[0]):
         i0 = starts[w]
         for j in range(6):
             x[0, j] = x0[w, j]
-        x[0, 6] = 0.0
+        x[0, 6] = inputs[i0, 0]
         for j in range(6):
             out[i0, j] = x[0, j]
         for k in range(i0, ends[w] - 1):
@@ -550,9 +552,12 @@ def _replay_kernel(t, starts, ends, x0, inputs, p, c, out):  # pragma: no cover 
             elif da < -math.pi:
                 da += 2.0 * math.pi
             u[0, 3] = a0 + 0.5 * da
+            if mmg:
+                u[0, 1] = 0.5 * (inputs[k, 4] + inputs[k + 1, 4])
+            x[0, 6] = u[0, 0]
             h = t[k + 1] - t[k]
-            rk4_stages(_vmm_deriv, 0, x, u, p, cc, h, 0, work[0], work[1], work[2], work[3],
-                       work[4])  # fmt: skip
+            rk4_stages(row_rhs_all, model_id, x, u, p, cc, h, 0, work[0], work[1], work[2],
+                       work[3], work[4])  # fmt: skip
             for j in range(6):
                 out[k + 1, j] = x[0, j]
 
@@ -586,7 +591,9 @@ def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | Non
         sel = np.arange(0, run.t.size, stride)
         t = run.t[sel]
         parts_t.append(t)
-        parts_u.append(np.column_stack((run.delta[sel], run.thrust[sel], run.wind[sel])))
+        parts_u.append(
+            np.column_stack((run.delta[sel], run.thrust[sel], run.wind[sel], run.rps[sel]))
+        )
         parts_m.append(run.measured[sel])
         run_of.append(np.full(sel.size, i))
         for s in window_starts(t, window_s):
@@ -608,16 +615,20 @@ def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | Non
 
 def replay(
     rp: _Replay,
-    params: VMMParams,
+    params: VMMParams | MMGParams,
     current: Sequence[float] = (0.0, 0.0),
     x0: np.ndarray | None = None,
 ) -> np.ndarray:
-    """``(n, 6)`` simulated ``x, y, psi, u, v, r`` of the replay windows (direct rudder), each
-    from the measured state (or from the rows of ``x0``)."""
+    """``(n, 6)`` simulated ``x, y, psi, u, v, r`` of the replay windows with the measured
+    rudder, each from the measured state (or from the rows of ``x0``); a VMM or the MMG model
+    (driven by the measured propeller revolutions)."""
     out = np.empty((rp.t.size, 7))
-    p = pack_vmm(replace(params, direct_rudder=True))
-    _replay_kernel(rp.t, rp.starts, rp.ends, rp.x0 if x0 is None else x0, rp.inputs, p,
-                   np.asarray(current, dtype=np.float64), out)  # fmt: skip
+    if isinstance(params, MMGParams):
+        model_id, p = KVLCC2, pack_mmg(params)
+    else:
+        model_id, p = VMM, pack_vmm(replace(params, direct_rudder=True))
+    _replay_kernel(model_id, rp.t, rp.starts, rp.ends, rp.x0 if x0 is None else x0, rp.inputs,
+                   p, np.asarray(current, dtype=np.float64), out)  # fmt: skip
     return out[:, :6]
 
 
@@ -673,6 +684,10 @@ class VMMFit:
         if "current" in self.effects:
             out["V_x"], out["V_y"] = self.current
         return out
+
+    def model_file(self) -> dict[str, Any]:
+        """The fitted model as :meth:`VMMParams.load` reads it (``{"vmm": ...}``)."""
+        return {"vmm": self.params.to_dict() | {"current": self.current}}
 
 
 def _terms_of(term_set: str | Sequence[str], effects: Sequence[str]) -> list[str]:
@@ -755,16 +770,19 @@ def _fit_windows(
     runs: Sequence[int],
     sigma: np.ndarray,
     start_scale: np.ndarray,
-    model: Callable[[np.ndarray], tuple[VMMParams, tuple[float, float]]],
+    model: Callable[[np.ndarray], tuple[VMMParams | MMGParams, tuple[float, float]]],
     theta0: np.ndarray,
     theta_scale: np.ndarray,
     max_nfev: int,
-) -> tuple[np.ndarray, np.ndarray, float, float]:
+    theta_bounds: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
     """Weighted least squares of the simulated ``psi, r, u, v`` of the windows of ``runs``
     over ``theta`` (the parameters ``model`` maps to a ship and a current) and the initial
     sway and yaw rate of every window (with a prior of ``start_scale``).
 
-    Returns the solution (``theta``), the start states ``x0``, and the costs before and after.
+    Returns the solution (``theta``), the start states ``x0``, the costs before and after,
+    and the standard errors of ``theta`` (from the Jacobian at the solution, the residual
+    variance estimated from the fit).
     """
     mask = rp.run_mask(runs)
     meas = rp.measured[mask]
@@ -787,14 +805,24 @@ def _fit_windows(
         return np.concatenate((e, (th[n_c:].reshape(-1, 2) / start_scale).ravel()))
 
     th0 = np.concatenate((theta0, np.zeros(2 * len(windows))))
+    free = np.full(2 * len(windows), np.inf)
+    unbounded = np.full(n_c, np.inf)
+    lo, hi = theta_bounds if theta_bounds is not None else (-unbounded, unbounded)
     r0 = resid(th0)
     # (scipy's trust region with a sparse Jacobian needs at least three unknowns)
     sol = least_squares(
         resid, th0, x_scale=np.concatenate((theta_scale, np.tile(start_scale, len(windows)))),
+        bounds=(np.concatenate((lo, -free)), np.concatenate((hi, free))),
         method="trf", max_nfev=max_nfev, jac_sparsity=sparsity if th0.size > 2 else None,
         xtol=1e-6, ftol=1e-6,
     )  # fmt: skip
-    return sol.x[:n_c], starts(sol.x), 0.5 * float(r0 @ r0), float(sol.cost)
+    stderr = np.full(n_c, np.nan)
+    if n_c:
+        jac = sol.jac.toarray() if hasattr(sol.jac, "toarray") else np.asarray(sol.jac)
+        dof = max(sol.fun.size - sol.x.size, 1)
+        cov = np.linalg.pinv(jac.T @ jac) * (2.0 * float(sol.cost) / dof)
+        stderr = np.sqrt(np.maximum(np.diag(cov)[:n_c], 0.0))
+    return sol.x[:n_c], starts(sol.x), 0.5 * float(r0 @ r0), float(sol.cost), stderr
 
 
 def _start_scale(rp: _Replay, length: float) -> np.ndarray:
@@ -841,7 +869,7 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20
         vals = dict(zip(extra, th[len(free) :], strict=True))
         return fit.params.with_coefficients(coeffs), (vals.get("V_x", 0.0), vals.get("V_y", 0.0))
 
-    theta, _, before, after = _fit_windows(
+    theta, _, before, after, _ = _fit_windows(
         rp, fit_runs, _channel_sigma(rp, fit_runs, fit), _start_scale(rp, fit.params.length),
         model, theta0, scale, max_nfev,
     )  # fmt: skip
@@ -855,7 +883,7 @@ def predict(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray:
     """Replay of ``fit`` with the initial sway and yaw rate of every window of ``runs``
     estimated from that window (the coefficients fixed; as a validation of a model on new
     data estimates its initial condition), the measured starts elsewhere."""
-    _, x0, _, _ = _fit_windows(
+    _, x0, _, _, _ = _fit_windows(
         rp, runs, _channel_sigma(rp, runs, fit), _start_scale(rp, fit.params.length),
         lambda _th: (fit.params, fit.current), np.zeros(0), np.zeros(0), 20,
     )  # fmt: skip
@@ -1077,7 +1105,7 @@ class VMMFamily(ModelFamily):
             raise ValueError(
                 "not identifiable from these records: the fitted model diverges when they are "
                 f"replayed ({sum(r.t.size for r in ctx.runs)} samples for "
-                f"{len(final_full.params.coefficients)} terms); fit several runs of the ship "
+                f"{len(final_full.values)} parameters); fit several runs of the ship "
                 "together (zigzags and turns), or a smaller term set"
             )
         for note in notes:
@@ -1140,10 +1168,135 @@ class VMMFamily(ModelFamily):
             "effect_parameters": {
                 e: self.effect_parameters(final_full, e) for e in final_full.effects
             },
-            "model_file": {"vmm": final_full.params.to_dict() | {"current": final_full.current}},
+            "model_file": final_full.model_file(),
         }
+
+
+# --------------------------------------------------------------------------------------------
+# the MMG model of the KVLCC2, its hull derivatives refined by output error
+
+MMG_FREE: tuple[str, ...] = ("r0", "y_v", "y_r", "n_v", "n_r")
+"""The MMG hull derivatives the ``kvlcc2`` family refines (the resistance and the linear sway
+and yaw derivatives, which set the course stability and hence the zigzag overshoots)."""
+
+MMG_FACTOR_BOUNDS = (0.5, 2.0)
+"""Bounds of the refined derivatives as factors of the published values (Yasukawa and
+Yoshimura 2015): a factor at a bound is a finding, not a result."""
+
+
+@dataclass
+class MMGFit:
+    """The MMG model refined on records (:class:`MMGFamily`).
+
+    Attributes
+    ----------
+    params : MMGParams
+        The model with the refined derivatives.
+    current : tuple of float
+        The current ``(V_x, V_y)`` [m/s] of the records.
+    effects : tuple of str
+        Effects in the model.
+    factors : dict
+        Refined derivative -> factor on the published value.
+    stderr : dict
+        Standard errors of the factors (from the output-error Jacobian).
+    """
+
+    params: MMGParams
+    current: tuple[float, float]
+    effects: tuple[str, ...]
+    factors: dict[str, float]
+    stderr: dict[str, float] = field(default_factory=dict)
+    refined: bool = True
+    regression: RegressionResult = field(
+        default_factory=lambda: RegressionResult({}, {}, {}, {}, {}, 0)
+    )
+
+    @property
+    def values(self) -> dict[str, float]:
+        """The refined derivatives (non-dimensional) and the effects' own parameters."""
+        out = {k: float(getattr(self.params, k)) for k in self.factors}
+        if "current" in self.effects:
+            out["V_x"], out["V_y"] = self.current
+        return out
+
+    @property
+    def at_bound(self) -> list[str]:
+        """Derivatives whose factor ended at :data:`MMG_FACTOR_BOUNDS`."""
+        lo, hi = MMG_FACTOR_BOUNDS
+        return [k for k, f in self.factors.items() if f <= lo * 1.001 or f >= hi * 0.999]
+
+    def model_file(self) -> dict[str, Any]:
+        """The refined MMG parameters (``{"kvlcc2": {field: value}}``)."""
+        from dataclasses import asdict
+
+        return {"kvlcc2": asdict(self.params) | {"current": self.current}}
+
+
+class MMGFamily(VMMFamily):
+    """The MMG standard model with the published KVLCC2 coefficients (``kvlcc2``), scaled to
+    the records' ship and driven by their rudder and propeller revolutions; the derivatives of
+    :data:`MMG_FREE` are refined by output error (multiple shooting as for the VMM) within
+    :data:`MMG_FACTOR_BOUNDS` of the published values, and the effect loop tries a current."""
+
+    def __init__(self) -> None:
+        super().__init__("martin")  # the VMM machinery for the runs; the model is the MMG
+        self.name = "kvlcc2"
+        self.catalogue = {"current": VMM_EFFECTS["current"]}
+
+    def candidates(self, current: Candidate) -> list[str]:
+        return [e for e in self.catalogue if e not in current.effects]
+
+    def _published(self, ctx: _Context) -> MMGParams:
+        return MMGParams.kvlcc2().scaled(ctx.template.length / 7.0)
+
+    def _fit(
+        self, ctx: _Context, effects: Sequence[str], runs: Sequence[int], refine_fit: bool,
+        start: MMGFit | None = None,
+    ) -> MMGFit:  # fmt: skip
+        published = self._published(ctx)
+        extra = ["V_x", "V_y"] if "current" in effects else []
+        f0 = [start.factors[k] if start else 1.0 for k in MMG_FREE]
+        c0 = list(start.current) if start and "current" in start.effects else [0.0, 0.0]
+        theta0 = np.array(f0 + c0[: len(extra)])
+        lo, hi = MMG_FACTOR_BOUNDS
+        bounds = (np.array([lo] * len(MMG_FREE) + [-2.0] * len(extra)),
+                  np.array([hi] * len(MMG_FREE) + [2.0] * len(extra)))  # fmt: skip
+
+        def model(th: np.ndarray) -> tuple[MMGParams, tuple[float, float]]:
+            changes = {k: getattr(published, k) * f for k, f in zip(MMG_FREE, th, strict=False)}
+            cur = (float(th[-2]), float(th[-1])) if extra else (0.0, 0.0)
+            return replace(published, **changes), cur
+
+        seed = MMGFit(published, (0.0, 0.0), tuple(effects), dict.fromkeys(MMG_FREE, 1.0))
+        theta, _, _, _, se = _fit_windows(
+            ctx.rp_fit, runs, _channel_sigma(ctx.rp_fit, runs, seed),
+            _start_scale(ctx.rp_fit, published.length), model, theta0,
+            np.array([0.1] * len(MMG_FREE) + [0.01] * len(extra)), 20, bounds,
+        )  # fmt: skip
+        params, cur = model(theta)
+        return MMGFit(
+            params, cur, tuple(effects), dict(zip(MMG_FREE, map(float, theta), strict=False)),
+            dict(zip([*MMG_FREE, *extra], map(float, se), strict=True)),
+        )  # fmt: skip
+
+    def _candidate(self, ctx: _Context, effects: Sequence[str], screen: Any = None) -> Candidate:
+        return self._score(ctx, self._fit(ctx, effects, ctx.train, True))
+
+    def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
+        return self._candidate(ctx, (*current.effects, name))
+
+    def _refit_all(self, ctx: _Context, cand: Candidate) -> MMGFit:
+        return self._fit(ctx, cand.effects, list(range(len(ctx.runs))), True, cand.fitted)
+
+    def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
+        cand = self._candidate(ctx, ())
+        if cand.fitted.at_bound:
+            say(f"  refined derivatives at a bound: {', '.join(cand.fitted.at_bound)}")
+        return cand
 
 
 for _name in TERM_SETS:
     register(VMMFamily(_name), f"vmm:{_name}")
 del _name
+register(MMGFamily())
