@@ -444,7 +444,7 @@ def render(doc: dict[str, Any]) -> str:
             "|---|" + "---:|" * len(names),
         ]
         for name, m in mm.items():
-            cells = [f"{m['factors'][k]:.2f} ± {m['stderr'][k]:.2f}" for k in names]
+            cells = [f"{m['factors'][k]:.2f} ± {m['stderr'][k]:.3f}" for k in names]
             lines.append(f"| {name.upper()} | " + " | ".join(cells) + " |")
         if zz_r:
             bound = ", ".join(k for m in mm.values() for k in m["at_bound"]) or "none"

@@ -1205,9 +1205,12 @@ def _build_identify(sub: Any) -> None:
             "Load a manoeuvre record (any of the measured-data formats or the canonical CSV), "
             "fit the base model by output error, then add effects of the catalogue (rudder "
             "offset, yaw nonlinearity, rudder lag, input delay, current, second order; for "
-            "rvg3dof its own catalogue) one at a time while the BIC on the held-out end of the "
-            "record improves. Prints the simulation errors before and after (heading, yaw "
-            "rate, and position / speed where recorded), the effects with their parameters and "
+            "rvg3dof and the 3-DOF models their own catalogues) one at a time while the BIC on "
+            "the held-out end of the record improves. The 3-DOF models (vmm:<term set>, seed "
+            "003's general model; kvlcc2, the MMG model with refined hull derivatives) take "
+            "several runs of one ship and hold every few runs out instead. Prints the "
+            "simulation errors before and after (heading, yaw rate, and position / speed where "
+            "recorded), the effects with their parameters and "
             "evidence, and the parameters. Progress and data-repair notes go to stderr."
         ),
     )
