@@ -339,3 +339,24 @@ def test_kvlcc2_mmg_derivatives_refined_on_hsva_runs() -> None:
     assert fit.factors["n_r"] < 1.0 - 3.0 * fit.stderr["n_r"]
     assert result.heldout["error_after"]["psi_rms_deg"] < 5.0
     assert result.to_dict()["kvlcc2"]["n_r"] == pytest.approx(fit.params.n_r)
+
+
+def test_the_abkowitz_set_on_a_linear_ship_reports_its_collinear_terms() -> None:
+    """Abkowitz's expansion multiplies every term by 1, u', u'^2 (Y_d, Y_ud, Y_uud; Y_0, Y_0u,
+    Y_0uu): with u' = u / U near 1 they are nearly one term, and the regression leaves all but
+    one out and says so, instead of fitting cancelling numbers. Summed at u' = 1, the kept
+    ones give the true derivatives of the linear ship."""
+    runs = generate_vmm_runs(None, n_runs=4, seed=3, noise=False)
+    truth = runs[0].meta["truth"]["coefficients"]
+    template = vessel_params(runs[0])
+    reg = regress(prepare_runs(runs, template), template, TERM_SETS["abkowitz"])
+    assert reg.r2["Y"] > 0.999 and reg.r2["N"] > 0.999
+    for eq in "XYN":
+        assert any(k.startswith(eq) for k in reg.collinear), eq
+    for followed in reg.collinear.values():
+        assert followed  # each left-out term names the kept terms it follows
+    c = reg.coefficients
+    for eq in "YN":
+        for x in ("v", "r", "d"):
+            at_one = c[f"{eq}_{x}"] + c[f"{eq}_u{x}"] + c[f"{eq}_uu{x}"]
+            assert at_one == pytest.approx(truth[f"{eq}_{x}"], rel=0.1), (eq, x)
