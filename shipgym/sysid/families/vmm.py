@@ -1023,17 +1023,17 @@ class VMMFamily(ModelFamily):
         return fit_vmm(ctx.runs, ctx.template, self.term_set, effects, rp=ctx.rp_fit,
                        fit_runs=runs, refine_fit=refine_fit and self.refine)  # fmt: skip
 
-    def _candidate(self, ctx: _Context, effects: Sequence[str], screen: Candidate | None = None
-                   ) -> Candidate:  # fmt: skip
-        """The refined model of ``effects`` (its regression-only screen under
-        ``extra["screen"]``)."""
+    def _candidate(
+        self, ctx: _Context, effects: Sequence[str], screen: Candidate | None = None
+    ) -> Candidate:
+        """The refined model of ``effects``, from its regression (``screen``, when scored
+        already)."""
         if screen is None:
             screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False))
         if not self.refine:
             return screen
         cand = self._score(ctx, refine(screen.fitted, ctx.rp_fit, ctx.train))
         cand.extra.update(screen.extra)
-        cand.extra["screen"] = screen
         return cand
 
     def _refit_all(self, ctx: _Context, cand: Candidate) -> VMMFit:
@@ -1280,7 +1280,10 @@ class MMGFamily(VMMFamily):
             dict(zip([*MMG_FREE, *extra], map(float, se), strict=True)),
         )  # fmt: skip
 
-    def _candidate(self, ctx: _Context, effects: Sequence[str], screen: Any = None) -> Candidate:
+    def _candidate(
+        self, ctx: _Context, effects: Sequence[str], screen: Candidate | None = None
+    ) -> Candidate:
+        """The MMG model with ``effects`` refined on the training runs (no regression)."""
         return self._score(ctx, self._fit(ctx, effects, ctx.train, True))
 
     def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
