@@ -36,6 +36,7 @@ from controllers.heading import (
     HeadingDesignReport,
     HeadingReferenceModel,
     default_bandwidth,
+    design_model,
     pid_gains_nomoto,
 )
 from controllers.los import IntegralLOS, LOSGuidance
@@ -68,6 +69,7 @@ __all__ = [
     "allocate_force_moment",
     "azimuth_to_action",
     "default_bandwidth",
+    "design_model",
     "linear_feedforward",
     "linearised_drag_model",
     "pid_gains_nomoto",

@@ -96,6 +96,7 @@ __all__ = [
     "HeadingDesignReport",
     "HeadingReferenceModel",
     "default_bandwidth",
+    "design_model",
     "pid_gains_nomoto",
 ]
 
@@ -201,6 +202,74 @@ def default_bandwidth(
     if T < 0:
         wn = max(wn, 2.0 / abs(T))
     return wn
+
+
+def design_model(
+    K: float,
+    T1: float,
+    T2: float = 0.0,
+    T3: float = 0.0,
+    *,
+    n1: float = 1.0,
+    omega: float | None = None,
+    **bandwidth: float | None,
+) -> tuple[float, float, float]:
+    """First-order Nomoto ``(K_e, T_e)`` to design a heading autopilot for any linear Nomoto
+    ship, and the design bandwidth ``w`` [rad/s].
+
+    The ship's yaw-rate response to the rudder, linearised about straight running, is
+
+    .. math:: \\frac{r}{\\delta}(s) = \\frac{K (1 + T_3 s)}{T_1 T_2 s^2 + (T_1 + T_2) s + n_1}
+
+    (first-order Nomoto: ``T2 = T3 = 0``; Norrbin's ``T r' + n_1 r + ... = K delta`` with ``T1 =
+    T``, which for ``n_1 < 0`` is a directionally unstable ship; second-order Nomoto and Bech
+    with ``n_1 = 1`` and ``n_1 = K b_1``). A first-order model ``K_e / (1 + T_e s)`` that
+    matches it **at the design bandwidth** is found from the complex response there:
+    ``1 / H(jw) = (1 + j w T_e) / K_e``, so ``K_e = 1 / Re(1/H)`` and
+    ``T_e = Im(1/H) / (w Re(1/H))``; ``w`` is :func:`default_bandwidth` of ``T_e`` and the
+    actuator data in ``bandwidth`` (``actuator_time_constant``, ``max_command``, ``max_rate``)
+    unless given, found by a fixed-point iteration. For the first-order ship the match is exact
+    (``K / n_1``, ``T / n_1``) at every frequency.
+
+    The classic reduction ``T = T_1 + T_2 - T_3`` matches the low-frequency expansion only, and
+    fails where the zero is slow: seed 004's ship (eq. 6: ``K`` 0.03, ``T_1`` 130 s, ``T_2`` 150
+    s, ``T_3`` 320 s) gets ``T = -40 s``, a stable ship designed as an unstable one, and that
+    pole-placement design destabilises the real plant. With the Mariner's steering gear, at its
+    bandwidth (0.028 rad/s) the ship behaves as ``K_e`` 0.044 1/s, ``T_e`` 87 s.
+
+    Returns
+    -------
+    tuple of float
+        ``(K_e, T_e, w)``.
+    """
+    K = finite("K", K)
+    T1 = finite("T1", T1)
+    T2 = nonnegative("T2", T2)
+    T3 = finite("T3", T3)
+    n1 = finite("n1", n1)
+    if K == 0 or T1 == 0 or n1 == 0:
+        raise ValueError(f"K, T1 and n1 must be non-zero, got K={K}, T1={T1}, n1={n1}")
+    if T2 == 0.0 and T3 == 0.0:
+        K_e, T_e = K / n1, T1 / n1
+        w = omega if omega is not None else default_bandwidth(T_e, **bandwidth)
+        return K_e, T_e, float(w)
+
+    def at(w: float) -> tuple[float, float]:
+        s = 1j * w
+        inv = (T1 * T2 * s * s + (T1 + T2) * s + n1) / (K * (1.0 + T3 * s))
+        return 1.0 / inv.real, inv.imag / (w * inv.real)
+
+    T_e = T1 + T2 - T3 if T1 + T2 - T3 != 0 else T1
+    w = omega if omega is not None else default_bandwidth(T_e, **bandwidth)
+    for _ in range(50 if omega is None else 1):
+        K_e, T_e = at(w)
+        if omega is not None:
+            break
+        w_new = default_bandwidth(T_e, **bandwidth)
+        if abs(w_new - w) <= 1e-9 * w:
+            break
+        w = w_new
+    return float(K_e), float(T_e), float(w)
 
 
 @dataclass(frozen=True, eq=False)

@@ -7,8 +7,10 @@ tracking the target's relative position and velocity as radar/AIS give them) fro
 the observation, run the controllers of :mod:`controllers`, and scale the physical commands to
 the env's actions with :class:`controllers.PodCommand`.
 
-Gains: the Nomoto ship's autopilot is designed by pole placement on its own first-order Nomoto
-parameters (``T = T1 + T2 - T3`` for the second-order models). R/V Gunnerus is directionally
+Gains: the Nomoto ship's autopilot is designed by pole placement on the first-order Nomoto
+model that matches its linear yaw response at the design bandwidth
+(:func:`controllers.design_model`; exact for the first-order models, the unstable Norrbin ship
+included). R/V Gunnerus is directionally
 unstable, so its autopilot is designed on the first-order Nomoto model that keeps the unstable
 sway-yaw pole and the initial yaw acceleration per unit azimuth of the linearised 3-DOF model
 (:func:`rvg_heading_nomoto`), with a slow reference model and a turn-rate limit so the swing can
@@ -29,6 +31,7 @@ from controllers import (
     HeadingAutopilot,
     PodCommand,
     SpeedAutopilot,
+    design_model,
     linearised_drag_model,
     quadratic_drag_feedforward,
 )
@@ -72,6 +75,22 @@ def rvg_heading_nomoto(speed: float = SERVICE_SPEED) -> tuple[float, float]:
     T = -1.0 / lam
     yaw_accel_per_azimuth = A[IR, IA1] + A[IR, IA2]
     return float(yaw_accel_per_azimuth * T), T
+
+
+def nomoto_heading_autopilot(model: Any, dt: float) -> HeadingAutopilot:
+    """The design-rule heading autopilot of a Nomoto-family ship: pole placement on the
+    first-order model that matches the ship's linear yaw response at the design bandwidth
+    (:func:`controllers.design_model`; the bandwidth from the steering gear and the ship)."""
+    y, gear = model.params, model.gear
+    if hasattr(y, "T1"):  # second-order Nomoto, Bech (linear part K b1 r)
+        args = (y.K, y.T1, y.T2, y.T3)
+        n1 = y.K * y.b1 if hasattr(y, "b1") else 1.0
+    else:  # first-order Nomoto, Norrbin (linear part n1 r)
+        args, n1 = (y.K, y.T), getattr(y, "n1", 1.0)
+    limits = {"actuator_time_constant": gear.time_constant, "max_command": gear.max_angle,
+              "max_rate": gear.max_rate}  # fmt: skip
+    K, T, omega = design_model(*args, n1=n1, **limits)
+    return HeadingAutopilot.from_nomoto(K, T, dt, omega_n=omega, **limits)
 
 
 def _rvg_heading_autopilot(
@@ -132,20 +151,11 @@ class NomotoHeadingClassic:
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         model = env.task.model
-        y = model.params
-        T = y.T if hasattr(y, "T") else y.T1 + y.T2 - y.T3
         gear = model.gear
         self.max_angle = gear.max_angle
         self.dt = env.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        self.pilot = HeadingAutopilot.from_nomoto(
-            y.K,
-            T,
-            env.dt,
-            max_command=gear.max_angle,
-            max_rate=gear.max_rate,
-            actuator_time_constant=gear.time_constant,
-        )
+        self.pilot = nomoto_heading_autopilot(model, env.dt)
         state = info["state"]
         self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
         self.t = 0.0
