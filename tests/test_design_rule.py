@@ -76,3 +76,20 @@ def test_first_order_ships_are_matched_exactly() -> None:
     assert (K, T) == (pytest.approx(-0.0925), pytest.approx(-53.65))
     with pytest.raises(ValueError, match="non-zero"):
         design_model(0.185, 107.3, n1=0.0)
+
+
+def test_seed004_case_on_its_own_ship() -> None:
+    """Seed 004's path-following case: the report's gains and the design rule finish the path;
+    the tuned pair (a faster heading loop, 300 m lookahead) keeps the straight-leg cross-track
+    error inside the report's +-200 m, the conservative design rule does not."""
+    from shipgym.benchmark.seed004 import run_seed004
+
+    design = run_seed004("design")
+    report = run_seed004("seed004")
+    tuned = run_seed004((0.07, 300.0))
+    assert design.finished and report.finished and tuned.finished
+    assert tuned.max_straight_m < 200.0
+    assert design.max_straight_m > tuned.max_straight_m
+    assert np.all(np.isfinite(tuned.cross_track))
+    with pytest.raises(ValueError, match="gains"):
+        run_seed004("fast")
