@@ -182,7 +182,12 @@ def test_evaluate_command_writes_json_and_plots(tmp_path: Path) -> None:
     assert summary["controller"] == "classic"
     assert summary["episodes"] == 2
     assert set(summary) >= {"mean_return", "std_return", "metrics"}
-    assert set(summary["metrics"]) == {"speed_rms_m_s"}
+    assert set(summary["metrics"]) == {
+        "speed_rms_m_s",
+        "settling_time_s",
+        "steady_state_m_s",
+        "energy_mj",
+    }
     assert len(list(plots.glob("*.png"))) == 2
 
 
@@ -194,3 +199,24 @@ def test_evaluate_rejects_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
         evaluate("shipgym/RVGSpeed-v0", make_policy("zero", "shipgym/RVGSpeed-v0"), "zero", 0)
     with pytest.raises(ValueError, match="unknown controller"):
         make_policy("dqn", "shipgym/RVGSpeed-v0")
+
+
+def test_engineering_metrics_against_hand_computed_signals() -> None:
+    """Settling time, steady-state error and rudder wear of made-up signals."""
+    from shipgym.benchmark.evaluate import HEADING_BAND, _settling, _wear
+
+    dt = 1.0
+    setpoint = np.array([0.0] * 10 + [1.0] * 10)
+    error = np.zeros(20)
+    error[10:14] = [1.0, 0.5, 0.1, 2.0 * HEADING_BAND]  # leaves the band last at sample 13
+    error[14:] = 0.01
+    settle, ss = _settling(error, setpoint, HEADING_BAND, dt)
+    assert settle == pytest.approx((0.0 + 4.0) / 2.0)  # segment 1 settled at once
+    assert ss == pytest.approx(np.sqrt(np.mean(np.r_[np.zeros(10), np.full(6, 0.01)] ** 2)))
+    # a rudder that swings +-10 deg every minute: 40 deg of travel and 2 reversals per minute
+    angle = np.radians(np.r_[np.linspace(0, 10, 16), np.linspace(10, -10, 31)[1:],
+                             np.linspace(-10, 0, 16)[1:]])  # fmt: skip
+    wear = _wear(angle, 1.0)
+    minutes = angle.size / 60.0
+    assert wear["rudder_travel_deg_min"] == pytest.approx(40.0 / minutes)
+    assert wear["rudder_reversals_min"] == pytest.approx(2.0 / minutes)

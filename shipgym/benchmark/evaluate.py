@@ -11,10 +11,25 @@ setpoints, paths, targets and current draws. Metrics (means over episodes):
   of the episode) and ``completed`` (fraction of episodes that reach the last waypoint);
 * target tracking: ``distance_error_rms_m`` and ``time_to_intercept_s`` (first time the distance
   is within 10 % of the set distance; the episode length if never).
+
+Engineering metrics beside them (what a control engineer signs off, not what the reward asks):
+
+* ``settling_time_s``: per setpoint segment, the time until the error stays inside the band
+  (:data:`HEADING_BAND` 2 deg, :data:`SPEED_BAND` 0.1 m/s; the segment length if never),
+  averaged over the segments; ``steady_state_deg`` / ``steady_state_m_s``: RMS error over the
+  settled samples;
+* ``rudder_travel_deg_min`` and ``rudder_reversals_min``: the rudder's (the pods' azimuth's)
+  total travel and number of direction reversals (moves above :data:`REVERSAL_DEADBAND`) per
+  minute, the wear of the steering gear;
+* ``energy_mj``: propulsion energy of the Gunnerus, the integral of thrust times surge speed
+  [MJ];
+* ``cross_track_straight_m``: RMS cross-track error on the straight parts of the legs
+  (:data:`STRAIGHT_AFTER_S` after each switch), apart from the turns.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import sys
 from collections.abc import Callable
@@ -28,13 +43,27 @@ import shipgym  # noqa: F401  (registers the environments)
 from shipgym.envs import ENV_IDS
 
 HEADING_ENVS = ("shipgym/NomotoHeading-v0", "shipgym/RVGHeading-v0")
+_WEAR = ("rudder_travel_deg_min", "rudder_reversals_min")
 METRICS: dict[str, tuple[str, ...]] = {
-    "shipgym/NomotoHeading-v0": ("heading_rms_deg", "overshoot_deg", "actuator_rms"),
-    "shipgym/RVGHeading-v0": ("heading_rms_deg", "overshoot_deg", "actuator_rms"),
-    "shipgym/RVGSpeed-v0": ("speed_rms_m_s",),
-    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", "cross_track_final_m", "completed"),
-    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", "time_to_intercept_s"),
-}
+    "shipgym/NomotoHeading-v0": ("heading_rms_deg", "overshoot_deg", "settling_time_s",
+                                 "steady_state_deg", "actuator_rms", *_WEAR),
+    "shipgym/RVGHeading-v0": ("heading_rms_deg", "overshoot_deg", "settling_time_s",
+                              "steady_state_deg", "actuator_rms", *_WEAR, "energy_mj"),
+    "shipgym/RVGSpeed-v0": ("speed_rms_m_s", "settling_time_s", "steady_state_m_s", "energy_mj"),
+    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", "cross_track_final_m",
+                                    "cross_track_straight_m", "completed", *_WEAR, "energy_mj"),
+    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", "time_to_intercept_s", *_WEAR,
+                                     "energy_mj"),
+}  # fmt: skip
+
+HEADING_BAND = math.radians(2.0)
+"""Settling band of the heading envs [rad]."""
+SPEED_BAND = 0.1
+"""Settling band of the speed env [m/s]."""
+STRAIGHT_AFTER_S = 60.0
+"""Path following: a leg counts as straight this long after the switch to it [s]."""
+REVERSAL_DEADBAND = math.radians(0.05)
+"""Rudder moves smaller than this [rad] are not counted as reversals."""
 
 
 @dataclass
@@ -126,37 +155,96 @@ def _ssa(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
+def _settling(error: np.ndarray, setpoint: np.ndarray, band: float, dt: float) -> tuple[
+    float, float
+]:  # fmt: skip
+    """Mean settling time [s] over the setpoint segments and the RMS of the settled error."""
+    times, settled = [], []
+    edges = [0, *(np.flatnonzero(np.diff(setpoint) != 0) + 1).tolist(), len(setpoint)]
+    for k0, k1 in itertools.pairwise(edges):
+        seg = np.abs(error[k0:k1])
+        outside = np.flatnonzero(seg > band)
+        first_in = 0 if outside.size == 0 else int(outside[-1]) + 1
+        times.append(first_in * dt)
+        settled.append(error[k0 + first_in : k1])
+    rest = np.concatenate(settled) if settled else np.zeros(0)
+    ss = float(np.sqrt(np.mean(rest**2))) if rest.size else math.nan
+    return float(np.mean(times)), ss
+
+
+def _wear(angle: np.ndarray, dt: float) -> dict[str, float]:
+    """Rudder travel [deg/min] and reversals per minute of a rudder/azimuth angle [rad]."""
+    minutes = max(angle.size * dt / 60.0, 1e-9)
+    step = np.diff(angle)
+    moves = step[np.abs(step) > REVERSAL_DEADBAND]
+    reversals = int(np.count_nonzero(np.diff(np.sign(moves)) != 0))
+    return {
+        "rudder_travel_deg_min": math.degrees(float(np.sum(np.abs(step)))) / minutes,
+        "rudder_reversals_min": reversals / minutes,
+    }
+
+
+def _rvg_energy_mj(states: np.ndarray, dt: float) -> float:
+    """Propulsion energy [MJ]: thrust of both pods times surge speed, integrated."""
+    power = (states[:, 6] + states[:, 7]) * states[:, 3]
+    return float(np.sum(np.maximum(power, 0.0)) * dt / 1e6)
+
+
 def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]:
     """The metrics of one episode of ``env_id`` (see the module docstring)."""
+    states = np.asarray(log.state, dtype=float)
+    rvg = env_id != "shipgym/NomotoHeading-v0"
+    rudder = states[:, 8] if rvg else states[:, 5]  # pod azimuth or rudder angle
+    extra: dict[str, float] = {}
+    if rvg:
+        extra["energy_mj"] = _rvg_energy_mj(states, dt)
     if env_id in HEADING_ENVS:
         e = log.signal("heading_error")
         a = np.asarray(log.action, dtype=float)
-        return {
+        settle, ss = _settling(e, log.signal("heading_setpoint"), HEADING_BAND, dt)
+        out = {
             "heading_rms_deg": math.degrees(float(np.sqrt(np.mean(e**2)))),
             "overshoot_deg": _overshoot_deg(log),
+            "settling_time_s": settle,
+            "steady_state_deg": math.degrees(ss),
             "actuator_rms": float(np.sqrt(np.mean(a**2))),
+            **_wear(rudder, dt),
         }
-    if env_id == "shipgym/RVGSpeed-v0":
+    elif env_id == "shipgym/RVGSpeed-v0":
         e = log.signal("speed_error")
-        return {"speed_rms_m_s": float(np.sqrt(np.mean(e**2)))}
-    if env_id == "shipgym/RVGPathFollowing-v0":
+        settle, ss = _settling(e, log.signal("speed_setpoint"), SPEED_BAND, dt)
+        out = {"speed_rms_m_s": float(np.sqrt(np.mean(e**2))), "settling_time_s": settle,
+               "steady_state_m_s": ss}  # fmt: skip
+    elif env_id == "shipgym/RVGPathFollowing-v0":
         e = log.signal("cross_track_error")
         tail = e[int(0.8 * len(e)) :]
-        return {
+        segment = log.signal("segment")
+        since = np.zeros(segment.size)
+        for k in range(1, segment.size):
+            since[k] = 0.0 if segment[k] != segment[k - 1] else since[k - 1] + dt
+        straight = e[since >= STRAIGHT_AFTER_S]
+        out = {
             "cross_track_rms_m": float(np.sqrt(np.mean(e**2))),
             "cross_track_final_m": float(np.mean(np.abs(tail))),
+            "cross_track_straight_m": (
+                float(np.sqrt(np.mean(straight**2))) if straight.size else math.nan
+            ),
             "completed": float(bool(log.info[-1]["completed"])),
+            **_wear(rudder, dt),
         }
-    if env_id == "shipgym/RVGTargetTracking-v0":
+    elif env_id == "shipgym/RVGTargetTracking-v0":
         err = log.signal("distance_error")
         dist = log.signal("distance")
         within = np.flatnonzero(np.abs(err) <= 0.1 * (dist - err))
         t_int = (within[0] + 1) * dt if within.size else len(err) * dt
-        return {
+        out = {
             "distance_error_rms_m": float(np.sqrt(np.mean(err**2))),
             "time_to_intercept_s": float(t_int),
+            **_wear(rudder, dt),
         }
-    raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    else:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    return {**out, **extra}
 
 
 def _start(
