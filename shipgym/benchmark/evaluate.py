@@ -60,8 +60,9 @@ HEADING_BAND = math.radians(2.0)
 """Settling band of the heading envs [rad]."""
 SPEED_BAND = 0.1
 """Settling band of the speed env [m/s]."""
-STRAIGHT_AFTER_S = 60.0
-"""Path following: a leg counts as straight this long after the switch to it [s]."""
+STRAIGHT_AFTER_S = 25.0
+"""Path following: a leg counts as straight this long after the switch to it [s] (the
+Gunnerus legs take 50-70 s; 25 s is about 4 ship lengths of travel)."""
 REVERSAL_DEADBAND = math.radians(0.05)
 """Rudder moves smaller than this [rad] are not counted as reversals."""
 
