@@ -84,7 +84,9 @@ def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     table = bench.table()
     assert "heading_rms_deg" in table and "stress" in table and " +- " in table
     md = render_markdown(entries, None)
-    assert md.count(f"| {ENV.split('/')[-1]} |") == 4
+    # four controllers in the main table, three paired against classic in two conditions
+    assert md.count(f"| {ENV.split('/')[-1]} |") == 4 + 3 * 2
+    assert "95 % interval" in md
 
 
 def test_seed_guard_refuses_training_seeds() -> None:

@@ -40,6 +40,7 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym  # noqa: F401  (registers the environments)
+from shipgym.benchmark.stats import bootstrap_ci
 from shipgym.envs import ENV_IDS
 
 HEADING_ENVS = ("shipgym/NomotoHeading-v0", "shipgym/RVGHeading-v0")
@@ -117,7 +118,8 @@ class EvaluationResult:
         return {k: float(np.std([m[k] for m in self.per_episode])) for k in keys}
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object: env, controller, condition, episodes, mean/std return, metrics."""
+        """The JSON object: env, controller, condition, episodes, mean/std return and its
+        bootstrap 95 % interval, the per-episode returns (for paired comparisons), metrics."""
         return {
             "env": self.env,
             "controller": self.controller,
@@ -126,8 +128,10 @@ class EvaluationResult:
             "seed": self.seed,
             "mean_return": float(np.mean(self.returns)),
             "std_return": float(np.std(self.returns)),
+            "return_ci95": list(bootstrap_ci(self.returns)) if self.episodes > 1 else None,
             "metrics": self.metrics,
             "metrics_std": self.metrics_std,
+            "returns": [float(r) for r in self.returns],
             "options": self.options,
         }
 

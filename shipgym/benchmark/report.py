@@ -11,11 +11,43 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from shipgym.benchmark.stats import paired_difference, verdict
+
 README_MARKER = "benchmark"
 
 
 def _pm(mean: float, std: float) -> str:
     return f"{mean:.3g} ± {std:.2g}"
+
+
+def paired_table(entries: Sequence[dict[str, Any]], reference: str = "classic") -> list[str]:
+    """Markdown lines: each controller's return against ``reference`` on the same seeds (mean
+    paired difference, bootstrap 95 % interval, verdict), nominal and stress."""
+    by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
+    rows = []
+    for (env_id, name, cond), e in by_key.items():
+        ref = by_key.get((env_id, reference, cond))
+        if name == reference or ref is None or "returns" not in e or "returns" not in ref:
+            continue
+        if len(e["returns"]) < 2 or len(e["returns"]) != len(ref["returns"]):
+            continue
+        mean, lo, hi = paired_difference(e["returns"], ref["returns"])
+        rows.append(
+            f"| {env_id.split('/')[-1]} | {cond} | {name} | {mean:+.3g} | "
+            f"[{lo:+.3g}, {hi:+.3g}] | {verdict(lo, hi)} |"
+        )
+    if not rows:
+        return []
+    return [
+        f"Return against `{reference}` on the same seeds: mean paired difference and its "
+        "bootstrap 95 % interval; a controller is better or worse only where the interval "
+        "excludes zero.",
+        "",
+        f"| env | condition | controller | return - {reference} | 95 % interval | verdict |",
+        "|---|---|---|---:|---|---|",
+        *rows,
+        "",
+    ]
 
 
 def render_markdown(
@@ -60,6 +92,7 @@ def render_markdown(
                 f"{metric_cells[0]} | {metric_cells[1]} |"
             )
     lines += ["", f"![benchmark metrics]({figure_dir}/metrics.png)", ""]
+    lines += paired_table(entries)
     if throughput:
         lines += [
             "PPO training throughput, the shipped agents' PPO settings (16 sub-envs, "
