@@ -757,7 +757,7 @@ def _build_benchmark(sub: Any) -> None:
     p.add_argument(
         "--episodes",
         type=_positive_int,
-        default=20,
+        default=100,
         metavar="N",
         help="episodes per env, controller and condition (%(default)s)",
     )

@@ -169,7 +169,7 @@ def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None
 
 
 def run_benchmark(
-    episodes: int = 20,
+    episodes: int = 100,
     seed: int = BENCHMARK_SEED,
     envs: Sequence[str] = ENV_IDS,
     controllers: Sequence[str] = CONTROLLERS,
