@@ -125,7 +125,7 @@ def _nomoto_sim(k: float, t_c: float, d0: float, t: np.ndarray, delta: np.ndarra
     return psi, r
 
 
-def _nomoto_windows(score: Any, runs: list[Any], which: list[int]) -> list[tuple[int, int, int]]:
+def _nomoto_windows(score: Any, which: list[int]) -> list[tuple[int, int, int]]:
     """(run, start, end) sample ranges (in the replay's concatenated samples) of ``which``."""
     out = []
     for w in range(score.starts.size):
@@ -135,11 +135,11 @@ def _nomoto_windows(score: Any, runs: list[Any], which: list[int]) -> list[tuple
     return out
 
 
-def _nomoto_fit(score: Any, runs: list[Any], which: list[int], theta: np.ndarray | None,
+def _nomoto_fit(score: Any, which: list[int], theta: np.ndarray | None,
                 length: float) -> tuple[np.ndarray, dict[str, float]]:  # fmt: skip
     """K, T, delta_0 (``theta`` given: fixed) and each window's initial yaw rate, fitted to
     heading and yaw rate over the windows of ``which``; returns theta and the psi/r RMS."""
-    wins = _nomoto_windows(score, runs, which)
+    wins = _nomoto_windows(score, which)
     meas = score.measured
     delta = score.inputs[:, 0]
     t = score.t
@@ -192,8 +192,8 @@ def _nomoto_fold(task: tuple[str, str, int, str]) -> dict[str, Any]:
     records = _records(Path(root), folder, pattern)
     template, runs, score, _ = _setup(records, None)
     train = [i for i in range(len(runs)) if i != left]
-    theta, _ = _nomoto_fit(score, runs, train, None, template.length)
-    _, err = _nomoto_fit(score, runs, [left], theta, template.length)
+    theta, _ = _nomoto_fit(score, train, None, template.length)
+    _, err = _nomoto_fit(score, [left], theta, template.length)
     return {"run": runs[left].name, "K": theta[0], "T": theta[1], "delta_0": theta[2], **err}
 
 
