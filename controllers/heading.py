@@ -15,7 +15,10 @@ Control law (seed 004 eq. 7 with the reference model's yaw rate fed forward)::
     e       = ssa(psi_d - psi)                                  heading error [rad]
     delta_c = Kp e + Ki integral(e dt) - Kd (r - r_d) + b0 [+ (T a_d + r_d) / K]
 
-followed by the actuator limits ``|delta_c| <= max_command`` and
+(seed 004 prints its eq. 7 with ``- Ki integral``: with the heading error ``e`` defined as here
+that integral pushes the ship away from the setpoint and the loop is unstable; ``+ Ki`` is
+right, a sign slip of the report's printing, not of its design), followed by the actuator
+limits ``|delta_c| <= max_command`` and
 ``|d delta_c / dt| <= max_rate``. ``b0`` is a constant rudder offset (seed 004 eq. 7); the
 integrator removes any remaining constant offset (a current, a bias ``n0``). The bracketed
 Nomoto feed-forward is optional. Anti-windup (``anti_windup``): the integrator is frozen while
