@@ -31,7 +31,7 @@ def _quiet(line: str) -> None:
 
 @pytest.fixture(scope="module")
 def bench():
-    return run_benchmark(episodes=3, envs=[ENV], progress=_quiet)
+    return run_benchmark(episodes=3, envs=[ENV], conditions=("nominal", "stress"), progress=_quiet)
 
 
 def test_every_controller_sees_the_same_scenarios(bench) -> None:
@@ -84,8 +84,9 @@ def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     table = bench.table()
     assert "heading_rms_deg" in table and "stress" in table and " +- " in table
     md = render_markdown(entries, None)
-    # four controllers in the main table, three paired against classic in two conditions
-    assert md.count(f"| {ENV.split('/')[-1]} |") == 4 + 3 * 2
+    # four controllers in the main and the robustness tables, three paired against classic in
+    # two conditions
+    assert md.count(f"| {ENV.split('/')[-1]} |") == 4 + 4 + 3 * 2
     assert "95 % interval" in md
 
 
@@ -136,7 +137,7 @@ def test_benchmark_command_writes_table_json_csv_and_figures(tmp_path: Path, cap
     assert "speed_rms_m_s" in out and "sac" in out
     entries = json.loads((tmp_path / "benchmark.json").read_text())
     assert {(e["controller"], e["condition"]) for e in entries} == {
-        (c, k) for c in ("classic", "ppo", "sac", "zero") for k in ("nominal", "stress")
+        (c, k) for c in ("classic", "ppo", "sac", "zero") for k in ("nominal", "stress", "mismatch")
     }
     assert (tmp_path / "benchmark.csv").stat().st_size > 0
     for name in ("metrics.png", "RVGSpeed-v0.png"):
@@ -199,3 +200,23 @@ def test_evaluate_shipped_agent_from_the_command_line(capsys) -> None:
     out = capsys.readouterr().out
     value = float(out.split("heading_rms_deg")[1].split()[0])
     assert np.isfinite(value) and value < 30.0
+
+
+def test_mismatch_condition_runs_the_wrong_ship_and_gains_stay_nominal() -> None:
+    """The mismatch condition steps the Bech Mariner while the classic autopilot keeps the
+    gains designed on the first-order Nomoto ship (as the agents keep their training)."""
+    from shipgym.benchmark.report import robustness_table
+    from shipgym.benchmark.runner import MISMATCH_KWARGS
+    from shipgym.envs import ENV_IDS
+
+    res = run_benchmark(
+        episodes=2, envs=["shipgym/NomotoHeading-v0"], controllers=["classic", "zero"],
+        conditions=("nominal", "mismatch"), progress=_quiet,
+    )  # fmt: skip
+    mism = res.get("shipgym/NomotoHeading-v0", "classic", "mismatch")
+    nom = res.get("shipgym/NomotoHeading-v0", "classic", "nominal")
+    assert mism.logs[0].state[0].size == 7 and nom.logs[0].state[0].size == 6  # bech: r_dot
+    assert mism.returns != nom.returns
+    assert set(MISMATCH_KWARGS) == set(ENV_IDS)
+    table = "\n".join(robustness_table(res.to_list()))
+    assert "| NomotoHeading-v0 | classic |" in table and "mismatch" in table

@@ -151,7 +151,7 @@ def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
                     yerr=stds,
                     capsize=2,
                     color=[_colour(n) for n in controllers],
-                    hatch="//" if cond == "stress" else None,
+                    hatch={"stress": "//", "mismatch": ".."}.get(cond),
                     edgecolor="k" if cond == "stress" else "none",
                     alpha=0.6 if cond == "stress" else 1.0,
                     label=cond,
@@ -163,7 +163,7 @@ def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
             )
             ax.grid(axis="y", alpha=0.3)
             if i == 0 and j == 0 and len(conditions) > 1:
-                ax.legend(fontsize=7, title="hatched = stress", title_fontsize=7)
+                ax.legend(fontsize=7, title="// stress, .. mismatch", title_fontsize=7)
     fig.suptitle(
         f"benchmark: {benchmark.episodes} episodes from seed {benchmark.seed} per bar "
         f"(mean, std); return: higher is better, errors: lower is better",

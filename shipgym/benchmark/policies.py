@@ -155,7 +155,10 @@ class NomotoHeadingClassic:
         self.max_angle = gear.max_angle
         self.dt = env.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        self.pilot = nomoto_heading_autopilot(model, env.dt)
+        # gains made on the nominal ship (the env's default model), as the agents are: a
+        # model-mismatch condition then tests both the same way
+        nominal = make_model("nomoto1", gear=gear, surge=model.surge)
+        self.pilot = nomoto_heading_autopilot(nominal, env.dt)
         state = info["state"]
         self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
         self.t = 0.0

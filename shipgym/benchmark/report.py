@@ -20,6 +20,38 @@ def _pm(mean: float, std: float) -> str:
     return f"{mean:.3g} ± {std:.2g}"
 
 
+def robustness_table(entries: Sequence[dict[str, Any]]) -> list[str]:
+    """Markdown lines: each controller's mean return per condition and its change from nominal
+    (who degrades more under stress and on the wrong ship)."""
+    conds = list(dict.fromkeys(e["condition"] for e in entries))
+    if len(conds) < 2 or "nominal" not in conds:
+        return []
+    by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
+    others = [c for c in conds if c != "nominal"]
+    lines = [
+        "Robustness: mean return per condition, and its change from nominal.",
+        "",
+        "| env | controller | nominal | " + " | ".join(others) + " |",
+        "|---|---|---:|" + "---:|" * len(others),
+    ]
+    for env_id in dict.fromkeys(e["env"] for e in entries):
+        for name in dict.fromkeys(e["controller"] for e in entries if e["env"] == env_id):
+            nominal = by_key.get((env_id, name, "nominal"))
+            if nominal is None:
+                continue
+            base = nominal["mean_return"]
+            cells = []
+            for cond in others:
+                e = by_key.get((env_id, name, cond))
+                cells.append(
+                    "—" if e is None else f"{e['mean_return']:.3g} ({e['mean_return'] - base:+.3g})"
+                )
+            lines.append(
+                f"| {env_id.split('/')[-1]} | {name} | {base:.3g} | " + " | ".join(cells) + " |"
+            )
+    return [*lines, ""]
+
+
 def paired_table(entries: Sequence[dict[str, Any]], reference: str = "classic") -> list[str]:
     """Markdown lines: each controller's return against ``reference`` on the same seeds (mean
     paired difference, bootstrap 95 % interval, verdict), nominal and stress."""
@@ -92,6 +124,7 @@ def render_markdown(
                 f"{metric_cells[0]} | {metric_cells[1]} |"
             )
     lines += ["", f"![benchmark metrics]({figure_dir}/metrics.png)", ""]
+    lines += robustness_table(entries)
     lines += paired_table(entries)
     if throughput:
         lines += [

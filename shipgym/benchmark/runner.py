@@ -1,14 +1,19 @@
-"""The benchmark: every env, every controller, identical scenarios, nominal and stressed.
+"""The benchmark: every env, every controller, identical scenarios, nominal, stressed and on
+the wrong ship.
 
 :func:`run_benchmark` evaluates the ``classic`` controller, the trained ``ppo`` and ``sac``
 agents and the ``zero`` command with :func:`shipgym.benchmark.evaluate.evaluate` on the same
 seeds (episode ``k`` has seed ``seed + k``: the same initial state, setpoints, path, target and
-current draw for every controller). Two conditions:
+current draw for every controller). Three conditions:
 
 * ``nominal``: the env's own current draws (speed uniform in ``[0, max_current_speed]``, the
   range the agents were trained on);
 * ``stress``: the current speed fixed at ``STRESS_FACTOR`` (1.5) times that training maximum,
-  with the same seeded directions.
+  with the same seeded directions (no different from nominal for the Nomoto ship: a uniform
+  current does not enter its yaw dynamics);
+* ``mismatch``: the same scenarios on a ship the agents and the classic gains were not made for
+  (:data:`MISMATCH_KWARGS`: the nonlinear Bech Mariner instead of the first-order Nomoto one;
+  the sea-trial Gunnerus instead of seed 001's).
 
 The default first seed, :data:`shipgym.rl.train.BENCHMARK_SEED`, lies outside every agent's
 training and validation seeds; :func:`run_benchmark` checks that against each agent's record.
@@ -33,9 +38,18 @@ from shipgym.envs import ENV_IDS
 from shipgym.rl.train import BENCHMARK_SEED
 
 CONTROLLERS = ("classic", "ppo", "sac", "zero")
-CONDITIONS = ("nominal", "stress")
+CONDITIONS = ("nominal", "stress", "mismatch")
 #: Stress condition: current speed as a multiple of the training maximum.
 STRESS_FACTOR = 1.5
+#: Model-mismatch condition: the ship the agents and gains were not made for (the nonlinear
+#: Bech Mariner for the first-order Nomoto env; the sea-trial Gunnerus for the seed-001 one).
+MISMATCH_KWARGS: dict[str, dict[str, Any]] = {
+    "shipgym/NomotoHeading-v0": {"model": "bech"},
+    "shipgym/RVGHeading-v0": {"params": "sea_trials"},
+    "shipgym/RVGSpeed-v0": {"params": "sea_trials"},
+    "shipgym/RVGPathFollowing-v0": {"params": "sea_trials"},
+    "shipgym/RVGTargetTracking-v0": {"params": "sea_trials"},
+}
 
 
 @dataclass
@@ -229,6 +243,7 @@ def run_benchmark(
     for env_id in envs:
         for condition in conditions:
             options = {"current_speed": stress_current[env_id]} if condition == "stress" else None
+            env_kwargs = MISMATCH_KWARGS[env_id] if condition == "mismatch" else None
             for name in controllers:
                 t0 = time.perf_counter()
                 result = evaluate(
@@ -237,6 +252,7 @@ def run_benchmark(
                     name,
                     episodes=episodes,
                     seed=seed,
+                    env_kwargs=env_kwargs,
                     reset_options=options,
                     progress=lambda line: None,
                     condition=condition,
