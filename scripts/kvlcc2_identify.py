@@ -10,9 +10,10 @@ Usage::
    output-error refinement of :mod:`shipgym.sysid.families.vmm`) and predicts the left-out run
    in windows of 15 ship lengths (89 s), each window's initial sway and yaw rate estimated from
    that window with the coefficients fixed. The first-order Nomoto model gets the same protocol
-   (K, T and a rudder offset fitted jointly on the other runs, each window's initial yaw rate
-   estimated). The within-run Nomoto held-out error of ``scripts/identify_all.py`` (fitted on
-   the first 70 % of the same run) is shown beside it when ``docs/identification.json`` has it.
+   (K, T and a rudder offset fitted jointly on the other runs through the package's Nomoto
+   replay, each window's initial yaw rate estimated). The within-run Nomoto held-out error of
+   ``scripts/identify_all.py`` (fitted on the first 70 % of the same run) is shown beside it
+   when ``docs/identification.json`` has it.
 2. **MARIN turning circles.** The VMM of the best HSVA term set is fitted on the other five
    MARIN runs (full scale, propeller loading from the rpm) and predicts each turning circle in
    300 s windows; the fitted model's own 35 deg turning circle gives the tactical diameter.
@@ -48,9 +49,10 @@ from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
 from shipgym import maneuvers
-from shipgym.models import make_model
+from shipgym.models import Nomoto1Params, make_model
 from shipgym.sysid import identify, load
 from shipgym.sysid.families import vmm as fv
+from shipgym.sysid.fit import replay
 from shipgym.sysid.report import update_readme, write_json
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -110,19 +112,12 @@ def _vmm_fold(task: tuple[str, str, int, str, str, float | None]) -> dict[str, A
 
 def _nomoto_sim(k: float, t_c: float, d0: float, t: np.ndarray, delta: np.ndarray,
                 psi0: float, r0: float) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """``T r' + r = K (delta + delta_0)``: exact for inputs held over each step (mid-step
-    rudder), heading by the trapezoidal rule."""
-    n = t.size
-    r = np.empty(n)
-    psi = np.empty(n)
-    r[0], psi[0] = r0, psi0
-    h = np.diff(t)
-    a = np.exp(-h / t_c)
-    u = k * (0.5 * (delta[1:] + delta[:-1]) + d0)
-    for i in range(n - 1):
-        r[i + 1] = a[i] * r[i] + (1.0 - a[i]) * u[i]
-        psi[i + 1] = psi[i] + 0.5 * h[i] * (r[i] + r[i + 1])
-    return psi, r
+    """Heading and yaw rate of ``T r' + r = K (delta + delta_0)`` replaying ``delta``, through
+    the package's own Nomoto replay (:func:`shipgym.sysid.fit.replay`)."""
+    x0 = np.zeros(6)
+    x0[2], x0[4] = psi0, r0
+    states = replay("nomoto1", Nomoto1Params(K=k, T=t_c), t, delta + d0, x0)
+    return states[:, 2], states[:, 4]
 
 
 def _nomoto_windows(score: Any, which: list[int]) -> list[tuple[int, int, int]]:

@@ -166,13 +166,14 @@ def run_seed004(
     x[0, model.index("U")] = speed
     pilot.reset(0.0, 0.0, t=0.0)
     n = round(max_time / dt)
-    out = np.full((n + 1, 4), np.nan)  # north, east, cross-track, leg
+    out = np.full((n + 1, 5), np.nan)  # north, east, cross-track, leg, along the leg
     t = 0.0
     k = 0
     for k in range(n + 1):
         s = x[0]
         chi_d = los.update(t, (s[0], s[1]), s[ipsi], s[ir])
-        out[k] = (s[0], s[1], los.cross_track_error, los.segment)
+        leg_start = los.path.waypoint_s[los.segment]
+        out[k] = (s[0], s[1], los.cross_track_error, los.segment, los.along_track - leg_start)
         if los.finished or not np.all(np.isfinite(s)):
             break
         delta = pilot.update(t, s[ipsi], s[ir], chi_d)
@@ -182,11 +183,7 @@ def run_seed004(
     out = out[: k + 1]
     time = dt * np.arange(out.shape[0])
     leg = out[:, 3].astype(int)
-    # along-track distance from the leg's first waypoint
-    start = SEED004_PATH[leg]
-    chi = np.arctan2(*(SEED004_PATH[np.minimum(leg + 1, len(SEED004_PATH) - 1)] - start).T[::-1])
-    along = (out[:, 0] - start[:, 0]) * np.cos(chi) + (out[:, 1] - start[:, 1]) * np.sin(chi)
-    straight = along > SETTLE_M
+    straight = out[:, 4] > SETTLE_M
     e = out[:, 2]
     on = e[straight]
     return Seed004Run(

@@ -70,7 +70,7 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.models._jit import row_kernel
+from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.kinematics import relative_motion, steering_gear
 
 __all__ = [
@@ -217,8 +217,6 @@ class VMMParams:
         ``D`` [m] (the loading ``rho D^4 n |n|`` of records without thrust).
     rho : float
         Water density [kg/m^3].
-    rudder_offset : float
-        Rudder angle the hydrodynamics see at zero rudder [rad] (identification effect).
     max_rudder, rudder_rate, rudder_time_constant : float
         Steering gear [rad, rad/s, s].
     include_c_a : bool
@@ -244,7 +242,6 @@ class VMMParams:
     approach_speed: float
     propeller_diameter: float = 0.0
     rho: float = 1025.0
-    rudder_offset: float = 0.0
     max_rudder: float = math.radians(35.0)
     rudder_rate: float = math.radians(15.8)
     rudder_time_constant: float = 0.05
@@ -361,7 +358,7 @@ _ADDED = ("X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot")
 _REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
                   "yaw_inertia", "added", "approach_speed")  # fmt: skip
 _OPTIONAL_KEYS = (
-    "propeller_diameter", "rho", "rudder_offset", "max_rudder", "rudder_rate",
+    "propeller_diameter", "rho", "max_rudder", "rudder_rate",
     "rudder_time_constant", "include_c_a", "direct_rudder", "thrust_from", "name",
 )  # fmt: skip
 
@@ -372,10 +369,9 @@ P_M, P_MXG = 5, 6  # m, m x_G
 P_XUD, P_YVD, P_YRD = 7, 8, 9  # dimensional X_udot, Y_vdot, Y_rdot (C_A; 0 if not included)
 P_QX, P_QN, P_L = 10, 11, 12  # rho/2 L^2, rho/2 L^3, L
 P_UMIN = 13
-P_OFFSET = 14  # rudder offset [rad]
-P_GEAR = 15  # max rudder, rate, 1 / T_delta, direct (1.0) or not
-P_NTERMS = 19
-P_TERMS = 20  # then per term: coefficient, equation, exponents (N_FACTORS)
+P_GEAR = 14  # max rudder, rate, 1 / T_delta, direct (1.0) or not
+P_NTERMS = 18
+P_TERMS = 19  # then per term: coefficient, equation, exponents (N_FACTORS)
 TERM_WIDTH = 2 + N_FACTORS
 
 
@@ -401,7 +397,6 @@ def pack_vmm(params: VMMParams) -> np.ndarray:
         p[P_XUD], p[P_YVD], p[P_YRD] = xud, yvd, yrd
     p[P_QX], p[P_QN], p[P_L] = half_rho * q.length**2, half_rho * q.length**3, q.length
     p[P_UMIN] = MIN_SPEED_FRACTION * q.approach_speed
-    p[P_OFFSET] = q.rudder_offset
     p[P_GEAR : P_GEAR + 4] = (
         q.max_rudder, q.rudder_rate, 1.0 / q.rudder_time_constant, float(q.direct_rudder),
     )  # fmt: skip
@@ -413,29 +408,41 @@ def pack_vmm(params: VMMParams) -> np.ndarray:
 
 
 @row_kernel
-def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
-    """``(X_D, Y_D, N_D)`` [N, N, N m] of the terms packed in ``p``."""
+def prime_factors(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
+    """The factors of the terms (:data:`FACTORS`, prime system) and ``U^2`` [m^2/s^2]."""
     big_u = max(math.sqrt(u_r * u_r + v_r * v_r), p[P_UMIN])
-    length = p[P_L]
     vp = v_r / big_u
-    rp = r * length / big_u
+    rp = r * p[P_L] / big_u
     u2 = big_u * big_u
     w2 = wind_speed * wind_speed / u2
     f = (
         u_r / big_u, vp, rp, delta, thrust / (p[P_QX] * u2), abs(vp), abs(rp), abs(delta),
         w2 * math.cos(wind_angle), w2 * math.sin(wind_angle), w2 * math.sin(2.0 * wind_angle),
     )  # fmt: skip
+    return f, u2
+
+
+@row_kernel
+def monomial(p, k, f):
+    """The monomial of term ``k`` of ``p`` at the factors ``f`` (without its coefficient)."""
+    b = P_TERMS + TERM_WIDTH * k
+    val = 1.0
+    for j in range(N_FACTORS):
+        for _ in range(int(p[b + 2 + j])):
+            val *= f[j]
+    return val
+
+
+@row_kernel
+def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
+    """``(X_D, Y_D, N_D)`` [N, N, N m] of the terms packed in ``p``."""
+    f, u2 = prime_factors(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p)
     sx = 0.0
     sy = 0.0
     sn = 0.0
-    n_terms = int(p[P_NTERMS])
-    for k in range(n_terms):
+    for k in range(int(p[P_NTERMS])):
         b = P_TERMS + TERM_WIDTH * k
-        val = p[b]
-        for j in range(N_FACTORS):
-            e = int(p[b + 2 + j])
-            for _ in range(e):
-                val *= f[j]
+        val = p[b] * monomial(p, k, f)
         eq = p[b + 1]
         if eq == 0.0:
             sx += val
@@ -444,6 +451,20 @@ def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
         else:
             sn += val
     return p[P_QX] * u2 * sx, p[P_QX] * u2 * sy, p[P_QN] * u2 * sn
+
+
+@kernel
+def term_monomials(x, inputs, p, c, out, u2):  # pragma: no cover - jit
+    """Regressors of the identification: the monomial of every packed term at every row of
+    states ``x`` ``(n, >= 6)`` and inputs ``(n, 4)`` into ``out`` ``(n, n_terms)``, and
+    ``U^2`` into ``u2`` (the same prime system as :func:`vmm_forces`)."""
+    scratch = np.empty(3)
+    for i in range(x.shape[0]):
+        ur, vr, _, _ = relative_motion(x[i], c, scratch)
+        u = inputs[i]
+        f, u2[i] = prime_factors(ur, vr, x[i, IR], u[0], u[1], u[2], u[3], p)
+        for k in range(out.shape[1]):
+            out[i, k] = monomial(p, k, f)
 
 
 @row_kernel
@@ -458,7 +479,7 @@ def vmm_row(x, u, p, c, out):
     else:
         delta = x[IDELTA]
         out[IDELTA] = steering_gear(delta, u[0], p[g], p[g + 1], p[g + 2])
-    fx, fy, fn = vmm_forces(ur, vr, r, delta + p[P_OFFSET], u[1], u[2], u[3], p)
+    fx, fy, fn = vmm_forces(ur, vr, r, delta, u[1], u[2], u[3], p)
     m = p[P_M]
     mxg = p[P_MXG]
     xud = p[P_XUD]

@@ -799,10 +799,9 @@ def vmm_truth() -> Any:
     stable linear term set (hull derivatives of Yasukawa and Yoshimura 2015 in the seed's
     prime system, ``N_r`` raised to make it course-stable; rudder and thrust terms of the HSVA
     fits)."""
-    from shipgym.sysid.families.vmm import vessel_params
+    from shipgym.sysid.families.vmm import kvlcc2_particulars
 
-    template = vessel_params(Record([0.0, 1.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0],
-                                    meta={"source": "hsva"}))  # fmt: skip
+    template = kvlcc2_particulars()
     coefficients = {
         "X_u": -0.0011, "X_v": 0.0, "X_r": 0.0, "X_d": 0.0, "X_T": 0.78,
         "Y_u": 0.0, "Y_v": -0.0205, "Y_r": 0.0054, "Y_d": -0.0032,

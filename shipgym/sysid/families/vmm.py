@@ -59,7 +59,7 @@ from shipgym.models.vmm import (
     clarke_added_masses,
     pack_vmm,
     propeller_loading,
-    term_matrix,
+    term_monomials,
     vmm_row,
 )
 from shipgym.sysid.data import Record
@@ -80,6 +80,7 @@ __all__ = [
     "RegressionResult",
     "VMMFamily",
     "VMMFit",
+    "kvlcc2_particulars",
     "prepare_runs",
     "refine",
     "regress",
@@ -164,7 +165,7 @@ _EFFECT_TERMS = {
 # particulars of the ships the project's records come from
 
 
-def _kvlcc2(length: float) -> VMMParams:
+def kvlcc2_particulars(length: float = 7.0) -> VMMParams:
     """KVLCC2 particulars (HSVA report: INSEAN model 2487) at ``length``, added masses of
     Yasukawa and Yoshimura (2015) in the seed's prime system."""
     mmg = MMGParams.kvlcc2()
@@ -225,9 +226,9 @@ def vessel_params(record: Record) -> VMMParams:
     if isinstance(record.meta.get("particulars"), dict):  # a record that states its ship
         return VMMParams.from_dict({**record.meta["particulars"], "coefficients": {}})
     if source == "hsva":
-        return _kvlcc2(7.0)
+        return kvlcc2_particulars()
     if source == "marin":
-        return _kvlcc2(7.0 * KVLCC2_SCALE)
+        return kvlcc2_particulars(7.0 * KVLCC2_SCALE)
     if source == "esso_osaka":
         return _esso_osaka()
     raise ValueError(
@@ -323,38 +324,18 @@ def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
 # inverse dynamics and regression
 
 
-def _monomials(terms: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """``(n, k)`` monomials of the term table ``terms`` at the factors ``f`` ``(n, 11)``."""
-    out = np.ones((f.shape[0], terms.shape[0]))
-    for k in range(terms.shape[0]):
-        for j, e in enumerate(terms[k, 1:]):
-            if e:
-                out[:, k] *= f[:, j] ** int(e)
-    return out
-
-
-def _factors(
-    run: _Run, params: VMMParams, current: Sequence[float]
+def _regressors(
+    run: _Run, model: VMMParams, current: Sequence[float]
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Prime factors ``(n, 11)`` of the terms and the speed through the water ``U``."""
-    psi = run.states[:, 2]
-    cs, sn = np.cos(psi), np.sin(psi)
-    uc = current[0] * cs + current[1] * sn
-    vc = -current[0] * sn + current[1] * cs
-    ur = run.states[:, 3] - uc
-    vr = run.states[:, 4] - vc
-    big_u = np.maximum(np.hypot(ur, vr), 0.1 * params.approach_speed)
-    u2 = big_u**2
-    vp = vr / big_u
-    rp = run.states[:, 5] * params.length / big_u
-    d = run.delta + params.rudder_offset
-    w2 = run.wind[:, 0] ** 2 / u2
-    g = run.wind[:, 1]
-    f = np.column_stack((
-        ur / big_u, vp, rp, d, run.thrust / (0.5 * params.rho * params.length**2 * u2),
-        np.abs(vp), np.abs(rp), np.abs(d), w2 * np.cos(g), w2 * np.sin(g), w2 * np.sin(2 * g),
-    ))  # fmt: skip
-    return f, big_u
+    """``(n, k)`` monomials of ``model``'s terms at the run's samples and the speed through the
+    water ``U`` (the prime system of :func:`shipgym.models.vmm.term_monomials`)."""
+    n = run.t.size
+    mono = np.empty((n, len(model.coefficients)))
+    u2 = np.empty(n)
+    inputs = np.column_stack((run.delta, run.thrust, run.wind))
+    term_monomials(run.states, inputs, pack_vmm(model), np.asarray(current, dtype=np.float64),
+                   mono, u2)  # fmt: skip
+    return mono, np.sqrt(u2)
 
 
 def _forces(run: _Run, params: VMMParams, current: Sequence[float]) -> np.ndarray:
@@ -450,31 +431,31 @@ def regress(
     -------
     RegressionResult
     """
-    table = term_matrix(list(terms))
     rows_f, rows_y, segments, lags = [], [], [], []
     start = 0
+    model = params.with_coefficients(dict.fromkeys(terms, 0.0))
     for run in runs:
-        f, big_u = _factors(run, params, current)
+        m, big_u = _regressors(run, model, current)
         forces = _forces(run, params, current)
         q = 0.5 * params.rho * params.length**2 * big_u**2
         prime = forces / np.column_stack((q, q, q * params.length))
-        rows_f.append(f)
+        rows_f.append(m)
         rows_y.append(prime)
-        n = f.shape[0]
+        n = m.shape[0]
         segments.append(slice(start, start + n))
         start += n
         h = float(np.median(np.diff(run.t)))
         lags.append(round(FILTER_LENGTHS * params.length / np.median(big_u) / h))
-    f = np.concatenate(rows_f)
+    mono = np.concatenate(rows_f)
     y = np.concatenate(rows_y)
-    mono = _monomials(table, f)
+    table = model.terms
     coefficients: dict[str, float] = {}
     se: dict[str, float] = {}
     collinear: dict[str, list[str]] = {}
     condition: dict[str, float] = {}
     r2: dict[str, float] = {}
     resid = np.zeros_like(y)
-    names = list(terms)
+    names = list(model.coefficients)
     for eq, label in enumerate("XYN"):
         idx = [k for k in range(len(names)) if table[k, 0] == eq]
         if not idx:
@@ -512,7 +493,7 @@ def regress(
             se[names[idx[j]]] = float(sd[b] / norms[j])
     coefficients = {k: coefficients[k] for k in names}
     se = {k: se[k] for k in names}
-    return RegressionResult(coefficients, se, collinear, condition, r2, int(f.shape[0]), resid)
+    return RegressionResult(coefficients, se, collinear, condition, r2, int(mono.shape[0]), resid)
 
 
 # --------------------------------------------------------------------------------------------
@@ -1002,14 +983,13 @@ class VMMFamily(ModelFamily):
             held = [i for i in range(len(records)) if i % k == k - 1] or [len(records) - 1]
             train = [i for i in range(len(records)) if i not in held]
         runs = prepare_runs(records, template)
-        if window_s == "auto":
-            speed = float(np.median(np.concatenate([np.hypot(r.states[:, 3], r.states[:, 4])
-                                                    for r in runs])))  # fmt: skip
-            window_s = self.window_lengths * template.length / max(speed, 1e-3)
-        rp = _build_replay(runs, template, window_s)
         speed = float(np.median(np.concatenate([np.hypot(r.states[:, 3], r.states[:, 4])
                                                 for r in runs])))  # fmt: skip
-        shooting = REFINE_WINDOW_LENGTHS * template.length / max(speed, 1e-3)
+        lengths_s = template.length / max(speed, 1e-3)  # one ship length of travel [s]
+        if window_s == "auto":
+            window_s = self.window_lengths * lengths_s
+        rp = _build_replay(runs, template, window_s)
+        shooting = REFINE_WINDOW_LENGTHS * lengths_s
         rp_fit = _build_replay(runs, template, min(shooting, window_s or math.inf))
         return _Context(runs, rp, rp_fit, train, held, template, window_s)
 
