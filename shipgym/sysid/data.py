@@ -113,6 +113,7 @@ __all__ = [
     "detect_format",
     "load",
     "load_all",
+    "wrap_angle",
 ]
 
 FORMATS: tuple[str, ...] = ("sspa", "marin", "hsva", "esso_osaka", "usv", "gunnerus", "canonical")
@@ -173,7 +174,7 @@ def _ssa(a: np.ndarray) -> np.ndarray:
     return np.mod(a + np.pi, 2.0 * np.pi) - np.pi
 
 
-def _wrap_angle(a: np.ndarray) -> np.ndarray:
+def wrap_angle(a: np.ndarray) -> np.ndarray:
     """Wrap to (-pi, pi] (the wind-angle convention); values already inside are kept bit for bit."""
     a = np.asarray(a, dtype=np.float64)
     outside = (a <= -np.pi) | (a > np.pi)
@@ -383,7 +384,7 @@ class Record:
             if name == "time":
                 chans[name] = t_new
             elif name in _ANGLE_CHANNELS:
-                chans[name] = _wrap_angle(np.interp(t_new, self.time, np.unwrap(value)))
+                chans[name] = wrap_angle(np.interp(t_new, self.time, np.unwrap(value)))
             else:
                 chans[name] = np.interp(t_new, self.time, value)
         meta = dict(self.meta)
@@ -915,7 +916,7 @@ def _load_esso(path: Path) -> Record:
     wind_speed = wind_angle = None
     if has_wind:
         wind_speed = data[:, ix["wind_velo_relative_mid [m/s]"]]
-        wind_angle = _wrap_angle(data[:, ix["wind_dir_relative_mid [rad]"]])
+        wind_angle = wrap_angle(data[:, ix["wind_dir_relative_mid [rad]"]])
         meta["conversions"].append(
             "wind_speed = wind_velo_relative_mid; wind_angle = wind_dir_relative_mid wrapped from"
             " [0, 2 pi) to (-pi, pi]: the source angle is already the apparent wind direction"
@@ -1116,7 +1117,7 @@ def _load_canonical(path: Path) -> Record:
     for name in _ANGLE_CHANNELS:
         angle = chans.get(name)
         if angle is not None and np.any((angle <= -np.pi) | (angle > np.pi)):
-            chans[name] = _wrap_angle(angle)
+            chans[name] = wrap_angle(angle)
             _warn(meta, f"{name} outside (-pi, pi]; wrapped to (-pi, pi]")
     if meta.get("irregular_sampling") is not True:
         _flag_irregular(t, meta)

@@ -157,7 +157,7 @@ from shipgym.models import (
 )
 from shipgym.models import rvg as _rvg
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IU, IX, IY
-from shipgym.sysid.data import Record
+from shipgym.sysid.data import Record, wrap_angle
 
 __all__ = [
     "BASE_MODELS",
@@ -943,7 +943,7 @@ def generate_vmm_runs(
         if wind_true:
             extra["wind_speed"] = np.abs(noisy(inp[:, 2], "wind_speed"))
             angle_noisy = noisy(inp[:, 3], "wind_angle")
-            extra["wind_angle"] = -((-angle_noisy + math.pi) % (2.0 * math.pi) - math.pi)
+            extra["wind_angle"] = wrap_angle(angle_noisy)
         records.append(
             Record(
                 time=res.time[sel],
