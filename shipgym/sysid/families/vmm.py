@@ -1230,9 +1230,10 @@ class MMGFamily(VMMFamily):
     :data:`MMG_FREE` are refined by output error (multiple shooting as for the VMM) within
     :data:`MMG_FACTOR_BOUNDS` of the published values, and the effect loop tries a current."""
 
-    def __init__(self) -> None:
-        super().__init__("martin")  # the VMM machinery for the runs; the model is the MMG
+    def __init__(self) -> None:  # the runs, replays and scoring of the VMM; no term set
         self.name = "kvlcc2"
+        self.particulars = None
+        self.refine = True
         self.catalogue = {"current": VMM_EFFECTS["current"]}
 
     def candidates(self, current: Candidate) -> list[str]:
