@@ -1,4 +1,4 @@
-"""Train every agent shipgym ships: PPO and SAC on each of the five envs.
+"""Train every agent shipgym ships: PPO and SAC on the newest version of each of the five envs.
 
     python scripts/train_all.py [--out DIR] [--only TEXT] [--algo ppo|sac] [--jobs N]
                                 [--timesteps N] [--seed S]
@@ -47,13 +47,17 @@ def _train_one(
 
 
 def main(argv: list[str] | None = None) -> int:
-    from shipgym.envs import ENV_IDS
+    from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS
     from shipgym.rl.agents import AGENT_DIR
-    from shipgym.rl.train import ALGOS
+    from shipgym.rl.train import ALGOS, config
 
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default=str(AGENT_DIR), help="agent folder (%(default)s)")
-    p.add_argument("--only", default=None, help="train only envs whose id contains TEXT")
+    p.add_argument(
+        "--only",
+        default=None,
+        help="train only envs whose id contains TEXT (default: the newest version of each)",
+    )
     p.add_argument("--algo", choices=ALGOS, default=None, help="train only this algorithm")
     p.add_argument("--jobs", type=int, default=2, help="agents trained at once (%(default)s)")
     p.add_argument("--timesteps", type=int, default=None, help="override every budget")
@@ -64,11 +68,18 @@ def main(argv: list[str] | None = None) -> int:
         p.error(f"--jobs must be >= 1, got {args.jobs}")
     jobs = [
         (env_id, algo)
-        for env_id in ENV_IDS
+        for env_id in (CURRENT_ENV_IDS if args.only is None else ENV_IDS)
         if args.only is None or args.only in env_id
         for algo in ALGOS
         if args.algo in (None, algo)
     ]
+    # longest first, so that the pool does not end on one long job (SAC steps cost about ten
+    # times PPO's: a gradient step per few env steps)
+    jobs.sort(
+        key=lambda job: (
+            -(args.timesteps or config(*job)["timesteps"]) * (10 if job[1] == "sac" else 1)
+        )
+    )
     if not jobs:
         p.error(f"no env id contains {args.only!r}; ids: {', '.join(ENV_IDS)}")
     threads = max(1, (os.cpu_count() or 1) // args.jobs)

@@ -34,7 +34,7 @@ import gymnasium as gym
 import numpy as np
 
 import shipgym
-from shipgym.envs import ENV_IDS
+from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS
 
 CARTPOLE_ID = "CartPole-v1"
 CARTPOLE_VECTOR = "CartPoleVectorEnv"
@@ -163,7 +163,7 @@ def run_bench(
     num_envs: int = DEFAULT_NUM_ENVS,
     repeats: int = DEFAULT_REPEATS,
     vec_steps: int | None = None,
-    env_ids: tuple[str, ...] = ENV_IDS,
+    env_ids: tuple[str, ...] = CURRENT_ENV_IDS,
     progress: TextIO | bool = True,
 ) -> dict[str, Any]:
     """Run the benchmark and return its results (the ``--json`` content).

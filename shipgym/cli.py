@@ -11,7 +11,7 @@ Subcommands::
                      [--agents DIR] [--json OUT] [--plot DIR]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
-                      [--env ID]... [--controller NAME]... [--no-stress] [--no-throughput]
+                      [--env ID]... [--controller NAME]... [--condition C]... [--no-throughput]
     shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
@@ -681,6 +681,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
 
     from shipgym.benchmark.plots import (
         plot_benchmark_metrics,
+        plot_benchmark_robustness,
         plot_benchmark_trajectories,
         plot_throughput,
     )
@@ -707,7 +708,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     result = run_benchmark(
         episodes=args.episodes,
         seed=args.seed,
-        conditions=CONDITIONS if not args.no_stress else ("nominal",),
+        conditions=args.condition or CONDITIONS,
         agents_dir=args.agents,
         progress=progress,
         **kwargs,
@@ -724,6 +725,8 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     print(f"wrote {json_path} and {csv_path}")
     plots.mkdir(parents=True, exist_ok=True)
     print(f"wrote {plot_benchmark_metrics(result, plots / 'metrics.png')}")
+    if len(result.conditions) > 1:
+        print(f"wrote {plot_benchmark_robustness(result, plots / 'robustness.png')}")
     for env_id in result.envs:
         name = env_id.split("/")[-1]
         print(f"wrote {plot_benchmark_trajectories(result, env_id, plots / f'{name}.png')}")
@@ -738,20 +741,23 @@ def _run_benchmark(args: argparse.Namespace) -> int:
 
 
 def _build_benchmark(sub: Any) -> None:
-    from shipgym.benchmark.runner import CONTROLLERS
+    from shipgym.benchmark.runner import CONDITIONS, CONTROLLERS
     from shipgym.envs import ENV_IDS
     from shipgym.rl.train import BENCHMARK_SEED
 
     p = sub.add_parser(
         "benchmark",
-        help="classic controllers vs the trained PPO/SAC agents vs zero on every env",
+        help="classic controllers (design-rule and tuned gains) vs the PPO/SAC agents vs zero",
         description=(
-            "Evaluate the classic controller, the shipped PPO and SAC agents and the zero "
-            "command on every env with identical seeds and current draws (seeds disjoint from "
-            "the agents' training and validation seeds), under the nominal currents and at "
-            "1.5 x the training maximum (stress). Prints a table of mean +- std of each metric, "
-            "writes JSON (a list of 'shipgym evaluate' objects) and CSV, figures of metrics "
-            "and trajectories, and PPO's training throughput on each env against CartPole-v1."
+            "Evaluate the classic controller with its design-rule gains and with its tuned "
+            "gains, the shipped PPO and SAC agents and the zero command on the newest version "
+            "of every env with identical seeds and current draws (seeds disjoint from the "
+            "agents' training and validation seeds and from the tuning seeds), in the nominal "
+            "condition and under stress (1.5 x the training current), model mismatch, sensor "
+            "noise and an actuator delay. Prints a table of mean +- std of each metric, "
+            "writes JSON (a list of 'shipgym evaluate' objects with per-episode values and "
+            "bootstrap 95 %% intervals) and CSV, figures of metrics, robustness and "
+            "trajectories, and PPO's training throughput on each env against CartPole-v1."
         ),
     )
     p.add_argument(
@@ -778,7 +784,7 @@ def _build_benchmark(sub: Any) -> None:
         choices=ENV_IDS,
         default=None,
         metavar="ID",
-        help="only this env (repeatable; default: all)",
+        help="only this env (repeatable; default: the newest version of each)",
     )
     p.add_argument(
         "--controller",
@@ -793,7 +799,13 @@ def _build_benchmark(sub: Any) -> None:
         metavar="DIR",
         help="folder of the ppo/sac agents (default: the shipped ones)",
     )
-    p.add_argument("--no-stress", action="store_true", help="skip the stress condition")
+    p.add_argument(
+        "--condition",
+        action="append",
+        choices=CONDITIONS,
+        default=None,
+        help="only this condition (repeatable; default: all)",
+    )
     p.add_argument(
         "--no-throughput", action="store_true", help="skip the PPO throughput measurement"
     )

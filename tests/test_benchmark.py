@@ -1,8 +1,8 @@
 """``shipgym benchmark`` and ``shipgym train``.
 
-The benchmark on identical seeds and current draws for every controller, the stress condition,
-its JSON/CSV/figures and the seed guard; the PPO throughput measurement; the command lines and
-their errors.
+The benchmark on identical seeds and current draws for every controller and condition (stress,
+mismatch, noise, delay), its JSON/CSV/figures with intervals and paired comparisons, and the
+seed guard; the PPO throughput measurement; the command lines and their errors.
 """
 
 from __future__ import annotations
@@ -16,13 +16,20 @@ import numpy as np
 import pytest
 
 from shipgym.benchmark.evaluate import METRICS
+from shipgym.benchmark.policies import make_policy
 from shipgym.benchmark.report import render_markdown
-from shipgym.benchmark.runner import STRESS_FACTOR, run_benchmark, training_max_current
+from shipgym.benchmark.runner import (
+    CONTROLLERS,
+    STRESS_FACTOR,
+    run_benchmark,
+    training_max_current,
+)
 from shipgym.benchmark.throughput import CARTPOLE, ppo_throughput
 from shipgym.cli import main
 from shipgym.rl.train import BENCHMARK_SEED
 
-ENV = "shipgym/RVGHeading-v0"
+ENV = "shipgym/RVGHeading-v1"
+CONDITIONS = ("nominal", "stress", "noise", "delay")
 
 
 def _quiet(line: str) -> None:
@@ -31,22 +38,30 @@ def _quiet(line: str) -> None:
 
 @pytest.fixture(scope="module")
 def bench():
-    return run_benchmark(episodes=3, envs=[ENV], conditions=("nominal", "stress"), progress=_quiet)
+    return run_benchmark(episodes=3, envs=[ENV], conditions=CONDITIONS, progress=_quiet)
 
 
 def test_every_controller_sees_the_same_scenarios(bench) -> None:
-    assert bench.controllers == ["classic", "ppo", "sac", "zero"]
-    assert bench.conditions == ["nominal", "stress"]
+    assert bench.controllers == list(CONTROLLERS)
+    assert bench.conditions == list(CONDITIONS)
+    nominal = None
     for cond in bench.conditions:
+        names = [n for n in bench.controllers if n != "zero" or cond == "nominal"]
         starts = [
             [
                 (log.seed, log.reset_info["current_direction"], tuple(log.reset_info["state"]))
                 for log in bench.get(ENV, name, cond).logs
             ]
-            for name in bench.controllers
+            for name in names
         ]
         assert all(s == starts[0] for s in starts)
         assert [s[0] for s in starts[0]] == [BENCHMARK_SEED + k for k in range(3)]
+        if cond in ("noise", "delay"):  # the same scenarios as nominal, only sensed or actuated
+            assert starts[0] == nominal
+        nominal = nominal or starts[0]
+    # the zero baseline runs in the nominal condition only
+    with pytest.raises(KeyError):
+        bench.get(ENV, "zero", "stress")
 
 
 def test_stress_fixes_the_current_at_one_and_a_half_the_training_maximum(bench) -> None:
@@ -62,19 +77,29 @@ def test_stress_fixes_the_current_at_one_and_a_half_the_training_maximum(bench) 
 
 def test_agents_and_the_classic_controller_beat_zero(bench) -> None:
     zero = bench.get(ENV, "zero").to_dict()["mean_return"]
-    for name in ("classic", "ppo", "sac"):
+    for name in ("classic", "classic-tuned", "ppo", "sac"):
         assert bench.get(ENV, name).to_dict()["mean_return"] > zero
 
 
 def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     entries = json.loads(bench.write_json(tmp_path / "b.json").read_text())
-    assert len(entries) == 8
+    cells = 5 + 4 * 3  # zero in nominal only
+    assert len(entries) == cells
     for e in entries:
         assert set(METRICS[ENV]) == set(e["metrics"]) == set(e["metrics_std"])
+        assert set(e["metrics_ci95"]) == set(e["per_episode"]) == set(METRICS[ENV])
         assert e["episodes"] == 3 and e["seed"] == BENCHMARK_SEED
+        assert len(e["returns"]) == 3 and len(e["termination"]) == 3
+        for key, values in e["per_episode"].items():
+            finite = [v for v in values if np.isfinite(v)]
+            assert e["metrics_defined"][key] == len(finite)
+            if len(finite) >= 2:
+                lo, hi = e["metrics_ci95"][key]
+                assert lo <= e["metrics"][key] <= hi
+                assert e["metrics"][key] == pytest.approx(np.mean(finite))
     with bench.write_csv(tmp_path / "b.csv").open() as fh:
         rows = list(csv.DictReader(fh))
-    assert len(rows) == 8 * (1 + len(METRICS[ENV]))
+    assert len(rows) == cells * (1 + len(METRICS[ENV]))
     ppo = [r for r in rows if r["controller"] == "ppo" and r["condition"] == "nominal"]
     assert {r["metric"] for r in ppo} == {"return", *METRICS[ENV]}
     expected = bench.get(ENV, "ppo").to_dict()["metrics"]["heading_rms_deg"]
@@ -84,10 +109,14 @@ def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     table = bench.table()
     assert "heading_rms_deg" in table and "stress" in table and " +- " in table
     md = render_markdown(entries, None)
-    # four controllers in the main and the robustness tables, three paired against classic in
-    # two conditions
-    assert md.count(f"| {ENV.split('/')[-1]} |") == 4 + 4 + 3 * 2
-    assert "95 % interval" in md
+    name = ENV.split("/")[-1]
+    # robustness rows for the four controllers run in every condition; the return against
+    # classic-tuned for four controllers in nominal and three in the other three conditions
+    assert md.count(f"| {name} |") == 4 + 4 + 3 * 3
+    assert f"**{name}**: controller - `classic-tuned`" in md
+    zero_row = next(line for line in md.splitlines() if line.startswith("| zero | -"))
+    assert zero_row.split("|")[2].strip().endswith("**worse**")  # zero's return, paired
+    assert "95 % interval" in md and "robustness.png" in md
 
 
 def test_seed_guard_refuses_training_seeds() -> None:
@@ -95,6 +124,9 @@ def test_seed_guard_refuses_training_seeds() -> None:
         run_benchmark(episodes=2, seed=0, envs=[ENV], controllers=["ppo"], progress=_quiet)
     with pytest.raises(ValueError, match="overlap the validation seeds"):
         run_benchmark(episodes=2, seed=100_001, envs=[ENV], controllers=["sac"], progress=_quiet)
+    with pytest.raises(ValueError, match="overlap the tuning seeds"):
+        run_benchmark(episodes=2, seed=14, envs=[ENV], controllers=["classic-tuned"],
+                      progress=_quiet)  # fmt: skip
 
 
 def test_benchmark_rejects_bad_arguments() -> None:
@@ -125,7 +157,7 @@ def test_benchmark_command_writes_table_json_csv_and_figures(tmp_path: Path, cap
             "--episodes",
             "2",
             "--env",
-            "shipgym/RVGSpeed-v0",
+            "shipgym/RVGSpeed-v1",
             "--no-throughput",
             "--out",
             str(tmp_path),
@@ -136,11 +168,12 @@ def test_benchmark_command_writes_table_json_csv_and_figures(tmp_path: Path, cap
     assert code == 0
     assert "speed_rms_m_s" in out and "sac" in out
     entries = json.loads((tmp_path / "benchmark.json").read_text())
+    conditions = ("nominal", "stress", "mismatch:seed001", "noise", "delay")
     assert {(e["controller"], e["condition"]) for e in entries} == {
-        (c, k) for c in ("classic", "ppo", "sac", "zero") for k in ("nominal", "stress", "mismatch")
+        (c, k) for c in CONTROLLERS for k in conditions if c != "zero" or k == "nominal"
     }
     assert (tmp_path / "benchmark.csv").stat().st_size > 0
-    for name in ("metrics.png", "RVGSpeed-v0.png"):
+    for name in ("metrics.png", "robustness.png", "RVGSpeed-v1.png"):
         assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -203,20 +236,28 @@ def test_evaluate_shipped_agent_from_the_command_line(capsys) -> None:
 
 
 def test_mismatch_condition_runs_the_wrong_ship_and_gains_stay_nominal() -> None:
-    """The mismatch condition steps the Bech Mariner while the classic autopilot keeps the
-    gains designed on the first-order Nomoto ship (as the agents keep their training)."""
+    """The mismatch condition steps the Bech and the Norrbin Mariner while the classic
+    autopilot keeps the gains designed on the first-order Nomoto ship (as the agents keep
+    their training); the Gunnerus v1 envs meet seed 001's ship, the v0 envs the sea-trial one."""
     from shipgym.benchmark.report import robustness_table
-    from shipgym.benchmark.runner import MISMATCH_KWARGS
+    from shipgym.benchmark.runner import MISMATCH_SHIPS
     from shipgym.envs import ENV_IDS
 
+    nomoto = "shipgym/NomotoHeading-v0"
     res = run_benchmark(
-        episodes=2, envs=["shipgym/NomotoHeading-v0"], controllers=["classic", "zero"],
+        episodes=2, envs=[nomoto], controllers=["classic", "zero"],
         conditions=("nominal", "mismatch"), progress=_quiet,
     )  # fmt: skip
-    mism = res.get("shipgym/NomotoHeading-v0", "classic", "mismatch")
-    nom = res.get("shipgym/NomotoHeading-v0", "classic", "nominal")
-    assert mism.logs[0].state[0].size == 7 and nom.logs[0].state[0].size == 6  # bech: r_dot
-    assert mism.returns != nom.returns
-    assert set(MISMATCH_KWARGS) == set(ENV_IDS)
+    assert res.conditions == ["nominal", "mismatch:bech", "mismatch:norrbin"]
+    bech = res.get(nomoto, "classic", "mismatch:bech")
+    norrbin = res.get(nomoto, "classic", "mismatch:norrbin")
+    nom = res.get(nomoto, "classic", "nominal")
+    assert bech.logs[0].state[0].size == 7 and nom.logs[0].state[0].size == 6  # bech: r_dot
+    assert len({tuple(r.returns) for r in (bech, norrbin, nom)}) == 3
+    # the gains stay those of the nominal ship
+    assert make_policy("classic", nomoto).nominal == "nomoto1"
+    assert set(MISMATCH_SHIPS) == set(ENV_IDS)
+    assert MISMATCH_SHIPS[ENV] == {"seed001": {"params": "seed001"}}
+    assert MISMATCH_SHIPS["shipgym/RVGHeading-v0"] == {"sea_trials": {"params": "sea_trials"}}
     table = "\n".join(robustness_table(res.to_list()))
-    assert "| NomotoHeading-v0 | classic |" in table and "mismatch" in table
+    assert "| NomotoHeading-v0 | classic |" in table and "mismatch:norrbin" in table

@@ -21,12 +21,14 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 import shipgym
-from shipgym.envs import NomotoHeadingEnv, RVGSpeedEnv
+from shipgym.envs import TASKS, NomotoHeadingEnv, RVGSpeedEnv, env_task
 from shipgym.envs.kernels import REASONS
 from shipgym.models.angles import ssa
 from shipgym.models.rvg import SERVICE_SPEED
 
-ENV_IDS = shipgym.ENV_IDS
+#: One id per task (every code path); the ``-v1`` ids differ only in the default parameter set
+#: and have their own tests below.
+ENV_IDS = tuple(e for e in shipgym.ENV_IDS if e.endswith("-v0"))
 NOMOTO = "shipgym/NomotoHeading-v0"
 RVG_HEADING = "shipgym/RVGHeading-v0"
 RVG_SPEED = "shipgym/RVGSpeed-v0"
@@ -139,10 +141,33 @@ def test_check_env_nomoto_models(model: str) -> None:
 
 def test_all_ids_registered() -> None:
     assert len(ENV_IDS) == 5
-    for env_id in ENV_IDS:
+    assert len(shipgym.ENV_IDS) == 9
+    for env_id in shipgym.ENV_IDS:
         spec = gym.spec(env_id)
         assert spec.vector_entry_point is not None
         assert spec.max_episode_steps == gym.make(env_id).unwrapped.task.max_episode_steps
+    assert shipgym.CURRENT_ENV_IDS == (NOMOTO, *(e.replace("-v0", "-v1") for e in RVG_IDS))
+    assert [env_task(e) for e in shipgym.CURRENT_ENV_IDS] == list(TASKS)
+    with pytest.raises(ValueError, match="unknown env"):
+        env_task("shipgym/RVGHeading-v7")
+
+
+@pytest.mark.parametrize("env_id", RVG_IDS)
+def test_v1_is_the_sea_trial_ship_and_v0_is_unchanged(env_id: str) -> None:
+    v1 = env_id.replace("-v0", "-v1")
+    assert gym.make(env_id).unwrapped.task.model.params.name == "seed001"
+    assert gym.make(v1).unwrapped.task.model.params.name == "sea_trials"
+    vec = gym.make_vec(v1, num_envs=2, vectorization_mode="vector_entry_point")
+    assert vec.task.model.params.name == "sea_trials"
+    _check_env_without_warnings(gym.make(v1))
+    # v1 is v0 with the sea-trial parameters: the same rollout to the last bit
+    actions = sampled_actions(gym.make(v1).action_space, 60, seed=3)
+    a = rollout(gym.make(v1), 11, actions)
+    b = rollout(gym.make(env_id, params="sea_trials"), 11, actions)
+    c = rollout(gym.make(env_id), 11, actions)
+    assert np.array_equal(a[-1][4]["state"], b[-1][4]["state"])
+    assert np.array_equal(a[-1][0], b[-1][0])
+    assert not np.array_equal(a[-1][4]["state"], c[-1][4]["state"])
 
 
 # --------------------------------------------------------------------------------------------

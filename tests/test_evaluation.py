@@ -16,14 +16,13 @@ import pytest
 
 from shipgym.benchmark import evaluate, make_policy
 from shipgym.benchmark.policies import (
-    RVG_LOOKAHEAD,
     RVGHeadingClassic,
     RVGPathClassic,
     RVGTargetClassic,
 )
 from shipgym.cli import main
-from shipgym.envs import ENV_IDS
-from shipgym.models.rvg import SERVICE_SPEED
+from shipgym.envs import ENV_IDS, env_task
+from shipgym.models.rvg import LPP, SERVICE_SPEED
 
 
 def _quiet(line: str) -> None:
@@ -63,7 +62,9 @@ def test_los_conditional_integrator_removes_the_cross_track_error_in_current() -
     assert steady0.min() > 2.0
     # and the error it keeps is the crab-angle error of proportional LOS, e = Delta tan(beta)
     beta = math.asin(0.5 / SERVICE_SPEED)
-    assert steady0.mean() == pytest.approx(RVG_LOOKAHEAD * math.tan(beta), rel=0.05)
+    assert steady0.mean() == pytest.approx(
+        RVGPathClassic.DESIGN["lookahead_lengths"] * LPP * math.tan(beta), rel=0.05
+    )
 
 
 @pytest.mark.parametrize("direction_deg", [0.0, 90.0, 180.0, 270.0])
@@ -126,11 +127,11 @@ def test_target_tracking_closes_and_holds_the_distance() -> None:
 
 #: For each env: (metric, classic must be below this fraction of zero's value).
 _MARGIN = {
-    "shipgym/NomotoHeading-v0": ("heading_rms_deg", 0.7),
-    "shipgym/RVGHeading-v0": ("heading_rms_deg", 0.5),
-    "shipgym/RVGSpeed-v0": ("speed_rms_m_s", 0.5),
-    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", 0.7),
-    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", 0.3),
+    "NomotoHeading": ("heading_rms_deg", 0.7),
+    "RVGHeading": ("heading_rms_deg", 0.5),
+    "RVGSpeed": ("speed_rms_m_s", 0.5),
+    "RVGPathFollowing": ("cross_track_rms_m", 0.7),
+    "RVGTargetTracking": ("distance_error_rms_m", 0.3),
 }
 
 
@@ -138,11 +139,11 @@ _MARGIN = {
 def test_classic_beats_zero_by_a_wide_margin(env_id: str) -> None:
     classic = evaluate(env_id, make_policy("classic", env_id), "classic", 3, 500, progress=_quiet)
     zero = evaluate(env_id, make_policy("zero", env_id), "zero", 3, 500, progress=_quiet)
-    metric, fraction = _MARGIN[env_id]
+    metric, fraction = _MARGIN[env_task(env_id)]
     assert classic.metrics[metric] < fraction * zero.metrics[metric]
     c, z = classic.to_dict(), zero.to_dict()
     assert c["mean_return"] > z["mean_return"] + 2 * max(c["std_return"], 1.0)
-    if env_id == "shipgym/RVGPathFollowing-v0":
+    if env_task(env_id) == "RVGPathFollowing":
         assert classic.metrics["completed"] > zero.metrics["completed"]
 
 

@@ -19,7 +19,7 @@ import torch
 from gymnasium.vector import AutoresetMode
 
 from shipgym.benchmark import evaluate, make_policy
-from shipgym.envs import ENV_IDS
+from shipgym.envs import CURRENT_ENV_IDS
 from shipgym.rl.agents import AGENT_DIR, agent_files, load_agent, load_meta
 from shipgym.rl.train import (
     ALGOS,
@@ -116,7 +116,7 @@ TINY = {
 
 
 @pytest.mark.parametrize("algo", ALGOS)
-@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("env_id", CURRENT_ENV_IDS)
 def test_tiny_training_learns_saves_and_records(env_id: str, algo: str, tmp_path: Path) -> None:
     torch.manual_seed(0)
     result = train(
@@ -195,7 +195,7 @@ def test_missing_agent_is_a_clear_error(tmp_path: Path) -> None:
 # ------------------------------------------------------------------------------------------
 # the shipped agents
 # ------------------------------------------------------------------------------------------
-SHIPPED = [(env_id, algo) for env_id in ENV_IDS for algo in ALGOS]
+SHIPPED = [(env_id, algo) for env_id in CURRENT_ENV_IDS for algo in ALGOS]
 
 
 @pytest.mark.parametrize(("env_id", "algo"), SHIPPED)

@@ -32,7 +32,7 @@ from __future__ import annotations
 import itertools
 import math
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -41,21 +41,26 @@ import numpy as np
 
 import shipgym  # noqa: F401  (registers the environments)
 from shipgym.benchmark.stats import bootstrap_ci
-from shipgym.envs import ENV_IDS
+from shipgym.envs import ENV_IDS, env_task
 
-HEADING_ENVS = ("shipgym/NomotoHeading-v0", "shipgym/RVGHeading-v0")
 _WEAR = ("rudder_travel_deg_min", "rudder_reversals_min")
-METRICS: dict[str, tuple[str, ...]] = {
-    "shipgym/NomotoHeading-v0": ("heading_rms_deg", "overshoot_deg", "settling_time_s",
-                                 "steady_state_deg", "actuator_rms", *_WEAR),
-    "shipgym/RVGHeading-v0": ("heading_rms_deg", "overshoot_deg", "settling_time_s",
-                              "steady_state_deg", "actuator_rms", *_WEAR, "energy_mj"),
-    "shipgym/RVGSpeed-v0": ("speed_rms_m_s", "settling_time_s", "steady_state_m_s", "energy_mj"),
-    "shipgym/RVGPathFollowing-v0": ("cross_track_rms_m", "cross_track_final_m",
-                                    "cross_track_straight_m", "completed", *_WEAR, "energy_mj"),
-    "shipgym/RVGTargetTracking-v0": ("distance_error_rms_m", "time_to_intercept_s", *_WEAR,
-                                     "energy_mj"),
+_TASK_METRICS: dict[str, tuple[str, ...]] = {
+    "NomotoHeading": ("heading_rms_deg", "overshoot_deg", "settling_time_s", "steady_state_deg",
+                      "actuator_rms", *_WEAR),
+    "RVGHeading": ("heading_rms_deg", "overshoot_deg", "settling_time_s", "steady_state_deg",
+                   "actuator_rms", *_WEAR, "energy_mj"),
+    "RVGSpeed": ("speed_rms_m_s", "settling_time_s", "steady_state_m_s", "energy_mj"),
+    "RVGPathFollowing": ("cross_track_rms_m", "cross_track_final_m", "cross_track_straight_m",
+                         "completed", *_WEAR, "energy_mj"),
+    "RVGTargetTracking": ("distance_error_rms_m", "time_to_intercept_s", *_WEAR, "energy_mj"),
 }  # fmt: skip
+#: The engineering metrics of each env, beside the return.
+METRICS: dict[str, tuple[str, ...]] = {e: _TASK_METRICS[env_task(e)] for e in ENV_IDS}
+#: The heading-keeping envs.
+HEADING_ENVS = tuple(e for e in ENV_IDS if env_task(e) in ("NomotoHeading", "RVGHeading"))
+
+#: Metrics where a larger value is better (for every other metric smaller is better).
+HIGHER_IS_BETTER = frozenset({"completed"})
 
 HEADING_BAND = math.radians(2.0)
 """Settling band of the heading envs [rad]."""
@@ -105,21 +110,47 @@ class EvaluationResult:
     options: dict[str, Any] = field(default_factory=dict)
     condition: str = "nominal"
 
+    def values(self, key: str) -> np.ndarray:
+        """Per-episode values of a metric (NaN where undefined: never settled)."""
+        return np.array([m[key] for m in self.per_episode], dtype=float)
+
+    def _over_defined(self, fn: Callable[[np.ndarray], float]) -> dict[str, float]:
+        out = {}
+        for k in METRICS[self.env]:
+            v = self.values(k)
+            v = v[np.isfinite(v)]
+            out[k] = float(fn(v)) if v.size else math.nan
+        return out
+
     @property
     def metrics(self) -> dict[str, float]:
-        """Means over episodes of each metric."""
-        keys = METRICS[self.env]
-        return {k: float(np.mean([m[k] for m in self.per_episode])) for k in keys}
+        """Means over the episodes where each metric is defined."""
+        return self._over_defined(np.mean)
 
     @property
     def metrics_std(self) -> dict[str, float]:
-        """Standard deviations over episodes of each metric."""
-        keys = METRICS[self.env]
-        return {k: float(np.std([m[k] for m in self.per_episode])) for k in keys}
+        """Standard deviations over the episodes where each metric is defined."""
+        return self._over_defined(np.std)
+
+    @property
+    def metrics_defined(self) -> dict[str, int]:
+        """Episodes in which each metric is defined (a steady-state error needs a settled
+        episode)."""
+        return {k: int(np.isfinite(self.values(k)).sum()) for k in METRICS[self.env]}
+
+    @property
+    def metrics_ci95(self) -> dict[str, list[float] | None]:
+        """Bootstrap 95 % interval of each metric's mean (``None`` below two values)."""
+        out: dict[str, list[float] | None] = {}
+        for k in METRICS[self.env]:
+            v = self.values(k)
+            out[k] = list(bootstrap_ci(v)) if np.isfinite(v).sum() >= 2 else None
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object: env, controller, condition, episodes, mean/std return and its
-        bootstrap 95 % interval, the per-episode returns (for paired comparisons), metrics."""
+        bootstrap 95 % interval, each metric's mean, std, interval and number of episodes
+        that define it, and the per-episode returns and metrics (for paired comparisons)."""
         return {
             "env": self.env,
             "controller": self.controller,
@@ -131,7 +162,13 @@ class EvaluationResult:
             "return_ci95": list(bootstrap_ci(self.returns)) if self.episodes > 1 else None,
             "metrics": self.metrics,
             "metrics_std": self.metrics_std,
+            "metrics_ci95": self.metrics_ci95,
+            "metrics_defined": self.metrics_defined,
             "returns": [float(r) for r in self.returns],
+            "per_episode": {k: [float(x) for x in self.values(k)] for k in METRICS[self.env]},
+            "termination": [
+                log.info[-1].get("termination_reason") if log.info else None for log in self.logs
+            ],
             "options": self.options,
         }
 
@@ -215,12 +252,12 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
             "actuator_rms": float(np.sqrt(np.mean(a**2))),
             **_wear(rudder, dt),
         }
-    elif env_id == "shipgym/RVGSpeed-v0":
+    elif env_task(env_id) == "RVGSpeed":
         e = log.signal("speed_error")
         settle, ss = _settling(e, log.signal("speed_setpoint"), SPEED_BAND, dt)
         out = {"speed_rms_m_s": float(np.sqrt(np.mean(e**2))), "settling_time_s": settle,
                "steady_state_m_s": ss}  # fmt: skip
-    elif env_id == "shipgym/RVGPathFollowing-v0":
+    elif env_task(env_id) == "RVGPathFollowing":
         e = log.signal("cross_track_error")
         tail = e[int(0.8 * len(e)) :]
         segment = log.signal("segment")
@@ -237,7 +274,7 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
             "completed": float(bool(log.info[-1]["completed"])),
             **_wear(rudder, dt),
         }
-    elif env_id == "shipgym/RVGTargetTracking-v0":
+    elif env_task(env_id) == "RVGTargetTracking":
         err = log.signal("distance_error")
         dist = log.signal("distance")
         within = np.flatnonzero(np.abs(err) <= 0.1 * (dist - err))
@@ -250,6 +287,12 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
     else:
         raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
     return {**out, **extra}
+
+
+def _wrapped(env: gym.Env, wrappers: Sequence[Callable[[gym.Env], gym.Env]]) -> gym.Env:
+    for wrap in wrappers:
+        env = wrap(env)
+    return env
 
 
 def _start(
@@ -292,6 +335,7 @@ def evaluate(
     reset_options: dict[str, Any] | None = None,
     progress: Callable[[str], None] | None = None,
     condition: str = "nominal",
+    wrappers: Sequence[Callable[[gym.Env], gym.Env]] = (),
 ) -> EvaluationResult:
     """Run ``policy`` for ``episodes`` episodes with seeds ``seed``, ``seed + 1``, ...
 
@@ -315,8 +359,12 @@ def evaluate(
     progress : callable, optional
         Called with a short line after each episode (default: print to stderr).
     condition : str
-        Name of the scenario set, recorded in the result (the benchmark's ``nominal`` or
-        ``stress``).
+        Name of the scenario set, recorded in the result (the benchmark's ``nominal``,
+        ``stress``, ...).
+    wrappers : sequence of callables
+        Applied to each env in order (``env = w(env)``), e.g. the robustness conditions'
+        :class:`~shipgym.envs.wrappers.SensorNoise` and
+        :class:`~shipgym.envs.wrappers.ActuatorDelay`. Metrics are of the true motion.
 
     Returns
     -------
@@ -333,7 +381,7 @@ def evaluate(
 
     batched = hasattr(policy, "act_batch")
     n_envs = episodes if batched else 1
-    envs = [gym.make(env_id, **(env_kwargs or {})) for _ in range(n_envs)]
+    envs = [_wrapped(gym.make(env_id, **(env_kwargs or {})), wrappers) for _ in range(n_envs)]
     dt = envs[0].unwrapped.dt
     logs: list[EpisodeLog] = []
     per_episode: list[dict[str, float]] = []

@@ -11,13 +11,14 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from shipgym.benchmark.evaluate import HEADING_ENVS, EpisodeLog, EvaluationResult
+from shipgym.envs import env_task
 
-_SIGNAL = {
-    "shipgym/NomotoHeading-v0": ("heading_error", "heading error [deg]", math.degrees(1.0)),
-    "shipgym/RVGHeading-v0": ("heading_error", "heading error [deg]", math.degrees(1.0)),
-    "shipgym/RVGSpeed-v0": ("speed_error", "speed error [m/s]", 1.0),
-    "shipgym/RVGPathFollowing-v0": ("cross_track_error", "cross-track error [m]", 1.0),
-    "shipgym/RVGTargetTracking-v0": ("distance_error", "distance error [m]", 1.0),
+_TASK_SIGNAL = {
+    "NomotoHeading": ("heading_error", "heading error [deg]", math.degrees(1.0)),
+    "RVGHeading": ("heading_error", "heading error [deg]", math.degrees(1.0)),
+    "RVGSpeed": ("speed_error", "speed error [m/s]", 1.0),
+    "RVGPathFollowing": ("cross_track_error", "cross-track error [m]", 1.0),
+    "RVGTargetTracking": ("distance_error", "distance error [m]", 1.0),
 }
 
 
@@ -55,7 +56,7 @@ def plot_episode(result: EvaluationResult, log: EpisodeLog, path: str | Path) ->
     FigureCanvasAgg(fig)
     grid = fig.add_gridspec(2, 2, width_ratios=(1.1, 1.0))
     _track(fig.add_subplot(grid[:, 0]), result, log)
-    key, label, scale = _SIGNAL[result.env]
+    key, label, scale = _TASK_SIGNAL[env_task(result.env)]
     t = np.asarray(log.time)
     ax = fig.add_subplot(grid[0, 1])
     ax.plot(t, log.signal(key) * scale, color="#1f5fa8")
@@ -100,7 +101,8 @@ def plot_result(result: EvaluationResult, out_dir: str | Path, max_episodes: int
 # ------------------------------------------------------------------------------------------
 #: One colour per controller, the same in every benchmark figure.
 CONTROLLER_COLOURS = {
-    "classic": "#1f5fa8",
+    "classic": "#7fa7d6",
+    "classic-tuned": "#1f5fa8",
     "ppo": "#c0392b",
     "sac": "#2e8b57",
     "zero": "#9a9a9a",
@@ -111,64 +113,108 @@ def _colour(name: str) -> str:
     return CONTROLLER_COLOURS.get(name, "#8e44ad")
 
 
+def _mean_ci(result: Any, key: str) -> tuple[float, float, float]:
+    """Mean and bootstrap 95 % interval of the return or a metric (NaN if undefined)."""
+    d = result.to_dict()
+    if key == "return":
+        mean, ci = d["mean_return"], d["return_ci95"]
+    else:
+        mean, ci = d["metrics"][key], d["metrics_ci95"][key]
+    lo, hi = ci if ci else (mean, mean)
+    return mean, lo, hi
+
+
 def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
-    """Bars of every metric (and the return), one row per env: mean and std over episodes.
+    """Bars of the return and every engineering metric in the nominal condition, one row per
+    env: the mean over episodes with its bootstrap 95 % interval, one colour per controller."""
+    from shipgym.benchmark.evaluate import HIGHER_IS_BETTER, METRICS
 
-    Each controller has its colour; the nominal condition is plain, the stress condition
-    hatched beside it.
-    """
-    from shipgym.benchmark.evaluate import METRICS
-
-    envs, controllers, conditions = benchmark.envs, benchmark.controllers, benchmark.conditions
+    envs, controllers = benchmark.envs, benchmark.controllers
     ncols = 1 + max(len(METRICS[e]) for e in envs)
-    fig = Figure(figsize=(3.4 * ncols, 2.6 * len(envs)), constrained_layout=True)
+    fig = Figure(figsize=(2.9 * ncols, 2.5 * len(envs)), constrained_layout=True)
     FigureCanvasAgg(fig)
     axes = np.atleast_2d(fig.subplots(len(envs), ncols, squeeze=False))
-    width = 0.8 / len(conditions)
     for i, env_id in enumerate(envs):
         keys = ("return", *METRICS[env_id])
+        names = [n for n in controllers if _has(benchmark, env_id, n, "nominal")]
         for j in range(ncols):
             ax = axes[i, j]
             if j >= len(keys):
                 ax.axis("off")
                 continue
             key = keys[j]
-            for c, cond in enumerate(conditions):
-                means, stds = [], []
-                for name in controllers:
-                    d = benchmark.get(env_id, name, cond).to_dict()
-                    if key == "return":
-                        means.append(d["mean_return"])
-                        stds.append(d["std_return"])
-                    else:
-                        means.append(d["metrics"][key])
-                        stds.append(d["metrics_std"][key])
-                x = np.arange(len(controllers)) + (c - (len(conditions) - 1) / 2) * width
-                ax.bar(
-                    x,
-                    means,
-                    width,
-                    yerr=stds,
-                    capsize=2,
-                    color=[_colour(n) for n in controllers],
-                    hatch={"stress": "//", "mismatch": ".."}.get(cond),
-                    edgecolor="k" if cond == "stress" else "none",
-                    alpha=0.6 if cond == "stress" else 1.0,
-                    label=cond,
-                )
-            ax.set_xticks(np.arange(len(controllers)), controllers, fontsize=8)
-            ax.set_title(
-                f"{env_id.split('/')[-1]}: {key}" if j == 0 else key,
-                fontsize=9,
+            stats = [_mean_ci(benchmark.get(env_id, n, "nominal"), key) for n in names]
+            means = np.array([m for m, _, _ in stats])
+            err = np.array([[m - lo for m, lo, _ in stats], [hi - m for m, _, hi in stats]])
+            ax.bar(
+                range(len(names)),
+                means,
+                0.75,
+                yerr=err,
+                capsize=2,
+                color=[_colour(n) for n in names],
             )
+            ax.set_xticks(range(len(names)), names, fontsize=7, rotation=30)
+            better = "higher" if key == "return" or key in HIGHER_IS_BETTER else "lower"
+            title = f"{key} ({better} better)"
+            ax.set_title(f"{env_id.split('/')[-1]}: {title}" if j == 0 else title, fontsize=8)
             ax.grid(axis="y", alpha=0.3)
-            if i == 0 and j == 0 and len(conditions) > 1:
-                ax.legend(fontsize=7, title="// stress, .. mismatch", title_fontsize=7)
     fig.suptitle(
-        f"benchmark: {benchmark.episodes} episodes from seed {benchmark.seed} per bar "
-        f"(mean, std); return: higher is better, errors: lower is better",
+        f"benchmark, nominal condition: {benchmark.episodes} episodes from seed "
+        f"{benchmark.seed} per bar (mean and bootstrap 95 % interval)",
         fontsize=11,
     )
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    return path
+
+
+def _has(benchmark: Any, env_id: str, name: str, cond: str) -> bool:
+    return any(
+        (r.env, r.controller, r.condition) == (env_id, name, cond) for r in benchmark.results
+    )
+
+
+def plot_benchmark_robustness(benchmark: Any, path: str | Path) -> Path:
+    """Mean return per condition (with its 95 % interval), one panel per env, one line per
+    controller: who degrades more, and by how much, away from the nominal condition."""
+    envs = benchmark.envs
+    fig = Figure(figsize=(3.6 * len(envs), 3.6), constrained_layout=True)
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(1, len(envs), squeeze=False)[0])
+    for ax, env_id in zip(axes, envs, strict=True):
+        conds = [
+            c
+            for c in benchmark.conditions
+            if any((r.env, r.condition) == (env_id, c) for r in benchmark.results)
+        ]
+        for name in benchmark.controllers:
+            pts = [
+                (k, *_mean_ci(benchmark.get(env_id, name, c), "return"))
+                for k, c in enumerate(conds)
+                if _has(benchmark, env_id, name, c)
+            ]
+            if len(pts) < 2:
+                continue
+            k, m, lo, hi = (np.array(v) for v in zip(*pts, strict=True))
+            ax.errorbar(
+                k,
+                m,
+                yerr=[m - lo, hi - m],
+                color=_colour(name),
+                marker="o",
+                ms=4,
+                capsize=2,
+                lw=1.2,
+                label=name,
+            )
+        ax.set_xticks(range(len(conds)), conds, fontsize=7, rotation=35)
+        ax.set_title(env_id.split("/")[-1], fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("mean return (95 % interval)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("robustness: the same seeds in every condition", fontsize=11)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
@@ -178,11 +224,14 @@ def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
 def plot_benchmark_trajectories(benchmark: Any, env_id: str, path: str | Path) -> Path:
     """The first episode of every controller on ``env_id``: track and key signal.
 
-    One row per condition; left the tracks (with the path or the target), right the task's
-    error signal over time. All controllers start from the same seeded scenario.
+    One row per condition (nominal and stress); left the tracks (with the path or the
+    target), right the task's error signal over time. All controllers start from the same
+    seeded scenario.
     """
-    conditions, controllers = benchmark.conditions, benchmark.controllers
-    key, label, scale = _SIGNAL[env_id]
+    conditions = [c for c in ("nominal", "stress") if c in benchmark.conditions]
+    conditions = conditions or benchmark.conditions[:1]
+    controllers = benchmark.controllers
+    key, label, scale = _TASK_SIGNAL[env_task(env_id)]
     fig = Figure(figsize=(13, 4.8 * len(conditions)), constrained_layout=True)
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(conditions), 2, squeeze=False, width_ratios=(1.0, 1.3))
@@ -190,8 +239,9 @@ def plot_benchmark_trajectories(benchmark: Any, env_id: str, path: str | Path) -
         ax_track, ax_sig = axes[i]
         first = None
         for name in controllers:
-            result = benchmark.get(env_id, name, cond)
-            log = result.logs[0]
+            if not _has(benchmark, env_id, name, cond):
+                continue
+            log = benchmark.get(env_id, name, cond).logs[0]
             first = first or log
             state = np.asarray(log.state)
             x0 = log.reset_info["state"]

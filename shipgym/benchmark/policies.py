@@ -7,14 +7,35 @@ tracking the target's relative position and velocity as radar/AIS give them) fro
 the observation, run the controllers of :mod:`controllers`, and scale the physical commands to
 the env's actions with :class:`controllers.PodCommand`.
 
-Gains: the Nomoto ship's autopilot is designed by pole placement on the first-order Nomoto
-model that matches its linear yaw response at the design bandwidth
-(:func:`controllers.design_model`; exact for the first-order models, the unstable Norrbin ship
-included). R/V Gunnerus is directionally
-unstable, so its autopilot is designed on the first-order Nomoto model that keeps the unstable
-sway-yaw pole and the initial yaw acceleration per unit azimuth of the linearised 3-DOF model
-(:func:`rvg_heading_nomoto`), with a slow reference model and a turn-rate limit so the swing can
-always be checked.
+Every classic controller is designed on the env's **nominal ship** (its default model or
+parameter set, as the agents are trained on it), so a model-mismatch condition tests gains and
+agents the same way. Its few design parameters (:attr:`DESIGN` of each class) come in two sets:
+
+``classic``: the design rules, per env:
+
+* NomotoHeading: PID by pole placement (seed 004 eq. 7) on the first-order Nomoto model that
+  matches the ship's linear yaw response at the design bandwidth
+  (:func:`controllers.design_model`); bandwidth ``w_n = sqrt(1 / (|T| T_a))`` between the
+  ship's and the actuator's time constants (Fossen's rule, :func:`controllers.default_bandwidth`,
+  ``T_a`` the rudder's full-scale slew time), damping 0.8, reference model at ``w_n``.
+* RVGHeading: the same pole placement on the first-order model that keeps the dominant
+  sway-yaw pole of the linearised 3-DOF Gunnerus (:func:`rvg_heading_nomoto`); bandwidth by
+  the same rule (for seed 001's directionally unstable ship at least ``2 / |T|``: the loop
+  must outrun the divergence); a slow step reference (0.1 rad/s, turn rate 0.03 rad/s) so
+  that a 90 deg step never overshoots.
+* RVGSpeed: PI by pole placement on the surge dynamics linearised at 4 m/s (seed 004 eq. 8),
+  ``w_n`` 0.1 rad/s (ten times the surge pole), critically damped, with the resistance
+  feed-forward of the nominal ship.
+* RVGPathFollowing: lookahead LOS with the conditional integrator (seed 004 eq. 9-10),
+  lookahead three ship lengths, the heading autopilot above with a faster reference (0.3
+  rad/s, 0.04 rad/s) so the heading loop stays inside the guidance loop, speed autopilot at
+  the service speed.
+* RVGTargetTracking: constant-bearing guidance (seed 004 eq. 11) with an approach speed of 2
+  m/s and ``Delta`` 100 m, heading autopilot with the step reference.
+
+``classic-tuned``: the same structures with design parameters chosen by a grid search on the
+RL training seeds (:mod:`shipgym.benchmark.tuning`); the chosen values and the search's record
+ship in ``shipgym/benchmark/tuned/``.
 """
 
 from __future__ import annotations
@@ -22,8 +43,9 @@ from __future__ import annotations
 import math
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
+import gymnasium as gym
 import numpy as np
 
 from controllers import (
@@ -33,54 +55,57 @@ from controllers import (
     SpeedAutopilot,
     design_model,
     linearised_drag_model,
-    quadratic_drag_feedforward,
 )
 from controllers.los import LOSGuidance
 from controllers.paths import WaypointPath
+from shipgym.envs import ENV_IDS, env_task
 from shipgym.models import make_model
-from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEED
-
-#: Gunnerus heading autopilot: closed-loop bandwidth [rad/s] of the pole placement.
-RVG_OMEGA_N = 0.3
-#: Reference model (frequency [rad/s], turn-rate limit [rad/s]) for setpoint steps: slow
-#: enough that a 30-90 deg step never overshoots (the ship is directionally unstable).
-RVG_STEP_REFERENCE = (0.1, 0.03)
-#: Reference model for LOS guidance, whose setpoints move smoothly: faster, so the heading
-#: loop stays well inside the guidance loop. (Target tracking keeps the step reference: its
-#: course-to-heading conversion uses the measured sideslip, which a fast loop excites.)
-RVG_GUIDANCE_REFERENCE = (0.3, 0.04)
-#: LOS lookahead for the Gunnerus: three ship lengths.
-RVG_LOOKAHEAD = 3.0 * LPP
+from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEED, RVGParams
 
 
 @cache
-def rvg_heading_nomoto(speed: float = SERVICE_SPEED) -> tuple[float, float]:
+def rvg_heading_nomoto(
+    speed: float = SERVICE_SPEED, params: str = "seed001"
+) -> tuple[float, float]:
     """First-order Nomoto ``(K, T)`` of the Gunnerus from common azimuth to yaw rate.
 
-    The 3-DOF model is linearised at straight running at ``speed`` (pods at the thrust that
-    holds it). ``T = -1 / lambda`` keeps the unstable sway-yaw eigenvalue ``lambda`` and
-    ``K / T`` is the initial yaw acceleration per radian of azimuth, so ``K / T < 0``
-    (positive azimuth turns to port) and ``T < 0`` (unstable).
+    The 3-DOF model with the parameter set ``params`` is linearised at straight running at
+    ``speed`` (pods at the thrust that holds it). ``T = -1 / lambda`` keeps the dominant
+    sway-yaw eigenvalue ``lambda`` (the largest real part: unstable, ``T < 0``, for seed 001's
+    parameters; stable, ``T`` 4.8 s, for the sea-trial ship) and ``K / T`` is the initial yaw
+    acceleration per radian of azimuth, so ``K / T < 0`` (positive azimuth turns to port).
     """
-    ship = make_model("rvg3dof")
-    p = ship.params
-    thrust = 0.5 * (p.linear_damping[0, 0] * speed + p.surge_quadratic_damping * speed**2)
+    ship = make_model("rvg3dof", params=params)
+    thrust = _rvg_thrust(ship.params, speed)
     x0 = np.zeros(ship.nx)
     x0[IU], x0[IT1], x0[IT2] = speed, thrust, thrust
     A, _ = ship.linearize(x0, [thrust, thrust, 0.0, 0.0])
     sway_yaw = A[np.ix_([IV, IR], [IV, IR])]
     lam = float(np.max(np.linalg.eigvals(sway_yaw).real))
-    if lam <= 0:
-        raise ValueError(f"expected a directionally unstable ship, largest eigenvalue {lam}")
+    if lam == 0:
+        raise ValueError("the sway-yaw dynamics have a zero eigenvalue: no Nomoto time constant")
     T = -1.0 / lam
     yaw_accel_per_azimuth = A[IR, IA1] + A[IR, IA2]
     return float(yaw_accel_per_azimuth * T), T
 
 
-def nomoto_heading_autopilot(model: Any, dt: float) -> HeadingAutopilot:
-    """The design-rule heading autopilot of a Nomoto-family ship: pole placement on the
-    first-order model that matches the ship's linear yaw response at the design bandwidth
-    (:func:`controllers.design_model`; the bandwidth from the steering gear and the ship)."""
+def _rvg_thrust(p: RVGParams, u: float) -> float:
+    """Per-pod thrust [N] that holds straight running at ``u`` in calm water."""
+    return p.straight_resistance(u) / (2.0 * (1.0 - p.thrust_deduction))
+
+
+def nomoto_heading_autopilot(
+    model: Any,
+    dt: float,
+    omega_n: float | None = None,
+    zeta: float = 0.8,
+    reference_ratio: float = 1.0,
+) -> HeadingAutopilot:
+    """The heading autopilot of a Nomoto-family ship: pole placement on the first-order model
+    that matches the ship's linear yaw response at the design bandwidth
+    (:func:`controllers.design_model`; the bandwidth from the steering gear and the ship
+    unless ``omega_n`` is given), damping ``zeta``, reference model at ``reference_ratio``
+    times the bandwidth (0: none)."""
     y, gear = model.params, model.gear
     if hasattr(y, "T1"):  # second-order Nomoto, Bech (linear part K b1 r)
         args = (y.K, y.T1, y.T2, y.T3)
@@ -89,42 +114,65 @@ def nomoto_heading_autopilot(model: Any, dt: float) -> HeadingAutopilot:
         args, n1 = (y.K, y.T), getattr(y, "n1", 1.0)
     limits = {"actuator_time_constant": gear.time_constant, "max_command": gear.max_angle,
               "max_rate": gear.max_rate}  # fmt: skip
-    K, T, omega = design_model(*args, n1=n1, **limits)
-    return HeadingAutopilot.from_nomoto(K, T, dt, omega_n=omega, **limits)
+    K, T, omega = design_model(*args, n1=n1, omega=omega_n, **limits)
+    return HeadingAutopilot.from_nomoto(
+        K, T, dt, omega_n=omega, zeta=zeta, reference_omega=reference_ratio * omega, **limits
+    )
 
 
 def _rvg_heading_autopilot(
-    dt: float, max_azimuth: float, reference: tuple[float, float]
+    dt: float,
+    max_azimuth: float,
+    params: str,
+    omega_n: float | None,
+    reference_omega: float,
+    max_turn_rate: float,
 ) -> HeadingAutopilot:
-    K, T = rvg_heading_nomoto()
-    params = make_model("rvg3dof").params
+    K, T = rvg_heading_nomoto(params=params)
+    p = RVGParams.named(params)
     return HeadingAutopilot.from_nomoto(
         K,
         T,
         dt,
-        omega_n=RVG_OMEGA_N,
-        reference_omega=reference[0],
-        max_turn_rate=reference[1],
+        omega_n=omega_n,
+        reference_omega=reference_omega,
+        max_turn_rate=max_turn_rate,
         max_command=max_azimuth,
-        max_rate=params.azimuth_max_rate,
-        actuator_time_constant=params.azimuth_time_constant,
+        max_rate=p.azimuth_max_rate,
+        actuator_time_constant=p.azimuth_time_constant,
     )
 
 
-def _rvg_speed_autopilot(dt: float, design_speed: float = 4.0) -> SpeedAutopilot:
-    p = make_model("rvg3dof").params
+def _rvg_speed_autopilot(
+    dt: float, params: str, omega_n: float, zeta: float, design_speed: float = 4.0
+) -> SpeedAutopilot:
+    """PI on each pod's thrust with the nominal ship's resistance as feed-forward; the
+    design model is the surge dynamics linearised at ``design_speed``."""
+    p = RVGParams.named(params)
     mass = p.mass + p.added_mass[0, 0]
-    d1, d2 = p.linear_damping[0, 0], p.surge_quadratic_damping
-    K, T = linearised_drag_model(mass, d1, d2, design_speed, share=0.5)
+    h = 1e-3 * design_speed
+    slope = (p.straight_resistance(design_speed + h) - p.straight_resistance(design_speed - h)) / (
+        2.0 * h
+    )
+    K, T = linearised_drag_model(
+        mass, slope, 0.0, design_speed, share=0.5 / (1.0 - p.thrust_deduction)
+    )
     return SpeedAutopilot.from_first_order(
         K,
         T,
         dt,
-        omega_n=0.1,
-        feedforward=quadratic_drag_feedforward(d1, d2, share=0.5),
+        omega_n=omega_n,
+        zeta=zeta,
+        feedforward=lambda u: _rvg_thrust(p, u),
         min_command=0.0,
         max_command=p.max_thrust,
     )
+
+
+def _measured(info: dict[str, Any]) -> np.ndarray:
+    """The state as the ship's sensors give it: ``info["measured_state"]`` under
+    :class:`shipgym.envs.wrappers.SensorNoise`, else the env's state."""
+    return info.get("measured_state", info["state"])
 
 
 def _speed_through_water(state: np.ndarray, current: tuple[float, float]) -> float:
@@ -146,8 +194,50 @@ class ZeroPolicy:
         return np.zeros((len(obs), self.act_dim), dtype=np.float32)
 
 
-class NomotoHeadingClassic:
-    """PID autopilot by pole placement on the ship's Nomoto ``K, T`` (seed 004 eq. 7)."""
+class ClassicPolicy:
+    """Base of the classic policies: the nominal ship and the design parameters.
+
+    Parameters
+    ----------
+    nominal : str
+        The nominal ship the controller is designed on: a Nomoto-family model name for the
+        Nomoto env, an RVG parameter set name (``"seed001"``, ``"sea_trials"``) for the
+        Gunnerus envs.
+    **design : float
+        Values for some of :attr:`DESIGN` (the rest keep their design-rule values).
+    """
+
+    #: Design parameters and their design-rule values (``None``: computed by the rule).
+    DESIGN: ClassVar[dict[str, float | None]] = {}
+    #: Default nominal ship.
+    NOMINAL: ClassVar[str] = "seed001"
+
+    def __init__(self, nominal: str | None = None, **design: float | None) -> None:
+        unknown = sorted(set(design) - set(self.DESIGN))
+        if unknown:
+            raise ValueError(
+                f"{type(self).__name__}: unknown design parameter(s) {unknown}; expected some "
+                f"of {sorted(self.DESIGN)}"
+            )
+        for key, value in design.items():
+            if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)):
+                raise ValueError(f"design parameter {key} must be a finite number, got {value!r}")
+        self.nominal = nominal or self.NOMINAL
+        self.design: dict[str, Any] = {**self.DESIGN, **design}
+
+
+class NomotoHeadingClassic(ClassicPolicy):
+    """PID autopilot by pole placement on the ship's Nomoto ``K, T`` (seed 004 eq. 7).
+
+    Design parameters: ``omega_n`` (closed-loop bandwidth [rad/s]; ``None``: Fossen's rule
+    from the steering gear and the ship), ``zeta`` (closed-loop damping) and
+    ``reference_ratio`` (reference-model frequency as a multiple of ``omega_n``; 0: none).
+    """
+
+    DESIGN: ClassVar[dict[str, float | None]] = {
+        "omega_n": None, "zeta": 0.8, "reference_ratio": 1.0,
+    }  # fmt: skip
+    NOMINAL: ClassVar[str] = "nomoto1"
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         model = env.task.model
@@ -155,46 +245,57 @@ class NomotoHeadingClassic:
         self.max_angle = gear.max_angle
         self.dt = env.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        # gains made on the nominal ship (the env's default model), as the agents are: a
-        # model-mismatch condition then tests both the same way
-        nominal = make_model("nomoto1", gear=gear, surge=model.surge)
-        self.pilot = nomoto_heading_autopilot(nominal, env.dt)
-        state = info["state"]
+        nominal = make_model(self.nominal, gear=gear, surge=model.surge)
+        self.pilot = nomoto_heading_autopilot(nominal, env.dt, **self.design)
+        state = _measured(info)
         self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
         self.t = 0.0
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        state = info["state"]
+        state = _measured(info)
         setpoint = info["heading_setpoint"]
         delta = self.pilot.update(self.t, state[self.ipsi], state[self.ir], setpoint)
         self.t += self.dt
         return np.array([delta / self.max_angle], dtype=np.float32)
 
 
-class RVGHeadingClassic:
-    """Gunnerus heading autopilot on the common pod azimuth."""
+class RVGHeadingClassic(ClassicPolicy):
+    """Gunnerus heading autopilot on the common pod azimuth.
+
+    Design parameters: ``omega_n`` (bandwidth [rad/s]; ``None``: the rule), and the reference
+    model's ``reference_omega`` [rad/s] and turn-rate limit ``max_turn_rate`` [rad/s].
+    """
+
+    DESIGN: ClassVar[dict[str, float | None]] = {
+        "omega_n": None, "reference_omega": 0.1, "max_turn_rate": 0.03,
+    }  # fmt: skip
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         self.dt = env.dt
         self.max_azimuth = env.task.max_azimuth
-        self.pilot = _rvg_heading_autopilot(env.dt, env.task.max_azimuth, RVG_STEP_REFERENCE)
-        state = info["state"]
+        self.pilot = _rvg_heading_autopilot(env.dt, self.max_azimuth, self.nominal, **self.design)
+        state = _measured(info)
         self.pilot.reset(state[2], state[IR], t=0.0)
         self.t = 0.0
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        state = info["state"]
+        state = _measured(info)
         azimuth = self.pilot.update(self.t, state[2], state[IR], info["heading_setpoint"])
         self.t += self.dt
         return PodCommand(azimuth, 0.0).to_env_action("heading", max_azimuth=self.max_azimuth)
 
 
-class RVGSpeedClassic:
-    """PI speed autopilot with drag feed-forward on the speed through the water."""
+class RVGSpeedClassic(ClassicPolicy):
+    """PI speed autopilot with resistance feed-forward on the speed through the water.
+
+    Design parameters: ``omega_n`` [rad/s] and ``zeta`` of the speed loop.
+    """
+
+    DESIGN: ClassVar[dict[str, float | None]] = {"omega_n": 0.1, "zeta": 1.0}
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         self.dt = env.dt
-        self.pilot = _rvg_speed_autopilot(env.dt)
+        self.pilot = _rvg_speed_autopilot(env.dt, self.nominal, **self.design)
         self.pilot.reset(t=0.0)
         self.t = 0.0
 
@@ -204,39 +305,46 @@ class RVGSpeedClassic:
         return PodCommand(0.0, thrust).to_env_action("speed")
 
 
-class RVGPathClassic:
+class RVGPathClassic(ClassicPolicy):
     """Lookahead LOS with the conditional integrator commanding the heading autopilot.
 
     As in seed 004 the LOS output is used as the heading setpoint (not course over ground);
     the integrator learns the crab angle that a current needs. A speed autopilot holds the
-    service speed through the water.
+    service speed through the water. Design parameters: ``lookahead_lengths`` (LOS lookahead
+    in ship lengths), the heading loop's ``omega_n``, ``reference_omega`` and
+    ``max_turn_rate``.
     """
 
-    def __init__(self, integral: bool = True, lookahead: float = RVG_LOOKAHEAD) -> None:
+    DESIGN: ClassVar[dict[str, float | None]] = {
+        "lookahead_lengths": 3.0, "omega_n": None, "reference_omega": 0.3, "max_turn_rate": 0.04,
+    }  # fmt: skip
+
+    def __init__(self, nominal: str | None = None, integral: bool = True, **design: float | None):
+        super().__init__(nominal, **design)
         self.integral = integral
-        self.lookahead = lookahead
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         task = env.task
         self.dt = env.dt
         self.max_azimuth = task.max_azimuth
+        d = dict(self.design)
         self.guidance = LOSGuidance(
             WaypointPath(task.waypoints(0)),
-            self.lookahead,
+            d.pop("lookahead_lengths") * LPP,
             integral=self.integral,
             design_speed=SERVICE_SPEED,
             switching="circle",
             acceptance_radius=task.accept_radius,
         )
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, RVG_GUIDANCE_REFERENCE)
-        self.speed = _rvg_speed_autopilot(env.dt)
-        state = info["state"]
+        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, self.nominal, **d)
+        self.speed = _rvg_speed_autopilot(env.dt, self.nominal, **RVGSpeedClassic.DESIGN)
+        state = _measured(info)
         self.heading.reset(state[2], state[IR], t=0.0)
         self.speed.reset(t=0.0)
         self.t = 0.0
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        state = info["state"]
+        state = _measured(info)
         current = (info["current_speed"], info["current_direction"])
         chi_d = self.guidance.update(self.t, state[:2], state[2], state[IR])
         azimuth = self.heading.update(self.t, state[2], state[IR], chi_d)
@@ -245,29 +353,40 @@ class RVGPathClassic:
         return PodCommand(azimuth, thrust).to_env_action("path", max_azimuth=self.max_azimuth)
 
 
-class RVGTargetClassic:
+class RVGTargetClassic(ClassicPolicy):
     """Constant-bearing guidance (seed 004 eq. 11) commanding heading and speed autopilots.
 
     The guidance gives a course and a speed over ground; the heading setpoint is that course
     minus the measured crab angle, and the speed autopilot holds the speed over ground.
+    Design parameters: ``approach_speed`` (``U_a,max`` [m/s]), ``delta`` (``Delta`` [m]), and
+    the heading loop's ``omega_n``, ``reference_omega``, ``max_turn_rate``.
     """
+
+    DESIGN: ClassVar[dict[str, float | None]] = {
+        "approach_speed": 2.0, "delta": 100.0, "omega_n": None, "reference_omega": 0.1,
+        "max_turn_rate": 0.03,
+    }  # fmt: skip
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         task = env.task
         self.dt = env.dt
         self.max_azimuth = task.max_azimuth
+        d = dict(self.design)
         self.guidance = ConstantBearingGuidance(
-            2.0, 100.0, float(task.distance[0]), max_speed=6.0, dt=env.dt
+            d.pop("approach_speed"), d.pop("delta"), float(task.distance[0]), max_speed=6.0,
+            dt=env.dt,
+        )  # fmt: skip
+        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, self.nominal, **d)
+        self.speed = _rvg_speed_autopilot(
+            env.dt, self.nominal, **RVGSpeedClassic.DESIGN, design_speed=3.0
         )
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, RVG_STEP_REFERENCE)
-        self.speed = _rvg_speed_autopilot(env.dt, design_speed=3.0)
-        state = info["state"]
+        state = _measured(info)
         self.heading.reset(state[2], state[IR], t=0.0)
         self.speed.reset(t=0.0)
         self.t = 0.0
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        state = info["state"]
+        state = _measured(info)
         psi = state[2]
         rot = np.array([[math.cos(psi), -math.sin(psi)], [math.sin(psi), math.cos(psi)]])
         target = state[:2] + rot @ obs[0:2]  # relative position, body -> NED
@@ -283,30 +402,52 @@ class RVGTargetClassic:
         return PodCommand(azimuth, thrust).to_env_action("target", max_azimuth=self.max_azimuth)
 
 
-_CLASSIC = {
-    "shipgym/NomotoHeading-v0": NomotoHeadingClassic,
-    "shipgym/RVGHeading-v0": RVGHeadingClassic,
-    "shipgym/RVGSpeed-v0": RVGSpeedClassic,
-    "shipgym/RVGPathFollowing-v0": RVGPathClassic,
-    "shipgym/RVGTargetTracking-v0": RVGTargetClassic,
+#: The classic policy of each task.
+CLASSIC: dict[str, type[ClassicPolicy]] = {
+    "NomotoHeading": NomotoHeadingClassic,
+    "RVGHeading": RVGHeadingClassic,
+    "RVGSpeed": RVGSpeedClassic,
+    "RVGPathFollowing": RVGPathClassic,
+    "RVGTargetTracking": RVGTargetClassic,
 }
 
-#: Names accepted by ``shipgym evaluate --controller``: the classic controller, the trained
-#: PPO and SAC agents (:mod:`shipgym.rl.agents`) and the neutral command.
-POLICIES = ("classic", "ppo", "sac", "zero")
+#: Names accepted by ``shipgym evaluate --controller``: the classic controller with its
+#: design-rule gains and with its tuned gains, the trained PPO and SAC agents
+#: (:mod:`shipgym.rl.agents`) and the neutral command.
+POLICIES = ("classic", "classic-tuned", "ppo", "sac", "zero")
+
+
+def nominal_ship(env_id: str) -> str:
+    """The nominal ship of ``env_id``: its default model (Nomoto env) or RVG parameter set."""
+    kwargs = gym.spec(env_id).kwargs
+    if env_task(env_id) == "NomotoHeading":
+        return str(kwargs.get("model", "nomoto1"))
+    return str(kwargs.get("params", "seed001"))
+
+
+def classic_policy(env_id: str, **design: float | None) -> ClassicPolicy:
+    """The classic policy of ``env_id`` on its nominal ship with design parameters
+    ``design`` (the rest at their design-rule values)."""
+    return CLASSIC[env_task(env_id)](nominal_ship(env_id), **design)
 
 
 def make_policy(name: str, env_id: str, agents_dir: str | Path | None = None) -> Any:
     """The policy ``name`` (one of :data:`POLICIES`) for ``env_id``.
 
-    ``ppo`` and ``sac`` load the shipped agents, or those in ``agents_dir``.
+    ``classic-tuned`` uses the tuned design parameters shipped for ``env_id``
+    (:func:`shipgym.benchmark.tuning.load_tuned`); ``ppo`` and ``sac`` load the shipped
+    agents, or those in ``agents_dir``.
     """
-    if env_id not in _CLASSIC:
-        raise ValueError(f"unknown env {env_id!r}; expected one of {tuple(_CLASSIC)}")
+    if env_id not in ENV_IDS:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
     if name == "zero":
         return ZeroPolicy()
     if name == "classic":
-        return _CLASSIC[env_id]()
+        return classic_policy(env_id)
+    if name == "classic-tuned":
+        from shipgym.benchmark.tuning import load_tuned
+
+        return classic_policy(env_id, **load_tuned(env_id)["design"])
     if name in ("ppo", "sac"):
         from shipgym.rl.agents import load_agent
 

@@ -11,33 +11,125 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
+
 from shipgym.benchmark.stats import paired_difference, verdict
 
 README_MARKER = "benchmark"
 
 
-def _pm(mean: float, std: float) -> str:
-    return f"{mean:.3g} ± {std:.2g}"
+#: The controller every other is compared with, episode by episode.
+REFERENCE = "classic-tuned"
+
+
+def _g(x: float) -> str:
+    return f"{x:.3g}"
+
+
+def _ci_cell(mean: float, ci: Sequence[float] | None, defined: int | None, episodes: int) -> str:
+    if mean != mean:  # NaN: defined in no episode
+        return "—"
+    cell = _g(mean) + (f" [{_g(ci[0])}, {_g(ci[1])}]" if ci else "")
+    if defined is not None and defined < episodes:
+        cell += f" (n={defined})"
+    return cell
+
+
+def _label(env_id: str) -> str:
+    return env_id.split("/")[-1]
+
+
+def metrics_tables(entries: Sequence[dict[str, Any]], condition: str = "nominal") -> list[str]:
+    """Markdown lines: per env, each controller's return and engineering metrics in
+    ``condition``: mean over episodes and its bootstrap 95 % interval (``n=`` where a metric is
+    defined in fewer episodes, e.g. a steady-state error needs a settled episode)."""
+    lines: list[str] = []
+    for env_id in dict.fromkeys(e["env"] for e in entries):
+        rows = [e for e in entries if e["env"] == env_id and e["condition"] == condition]
+        if not rows:
+            continue
+        keys = list(rows[0]["metrics"])
+        lines += [
+            f"**{_label(env_id)}**",
+            "",
+            "| controller | return | " + " | ".join(keys) + " |",
+            "|---|" + "---:|" * (1 + len(keys)),
+        ]
+        for e in rows:
+            n = e["episodes"]
+            cells = [_ci_cell(e["mean_return"], e.get("return_ci95"), None, n)]
+            cells += [
+                _ci_cell(e["metrics"][k], e["metrics_ci95"][k], e["metrics_defined"][k], n)
+                for k in keys
+            ]
+            lines.append(f"| {e['controller']} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
+
+
+def _paired_cell(a: Sequence[float], b: Sequence[float], higher_is_better: bool) -> str:
+    both = np.isfinite(np.asarray(a, dtype=float)) & np.isfinite(np.asarray(b, dtype=float))
+    if both.sum() < 2:
+        return "—"
+    mean, lo, hi = paired_difference(np.asarray(a)[both], np.asarray(b)[both])
+    word = verdict(lo, hi, higher_is_better)
+    mark = {"better": " **better**", "worse": " **worse**"}.get(word, "")
+    return f"{mean:+.3g} [{lo:+.3g}, {hi:+.3g}]{mark}"
+
+
+def paired_metrics_tables(
+    entries: Sequence[dict[str, Any]], reference: str = REFERENCE, condition: str = "nominal"
+) -> list[str]:
+    """Markdown lines: per env, each controller minus ``reference`` on the same seeds, for the
+    return and every metric: mean paired difference, bootstrap 95 % interval, and a verdict
+    only where the interval excludes zero."""
+    from shipgym.benchmark.evaluate import HIGHER_IS_BETTER
+
+    lines: list[str] = []
+    by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
+    for env_id in dict.fromkeys(e["env"] for e in entries):
+        ref = by_key.get((env_id, reference, condition))
+        if ref is None or "per_episode" not in ref:
+            continue
+        keys = list(ref["metrics"])
+        body = []
+        for (env, name, cond), e in by_key.items():
+            if (env, cond) != (env_id, condition) or name == reference:
+                continue
+            cells = [_paired_cell(e["returns"], ref["returns"], True)]
+            cells += [
+                _paired_cell(e["per_episode"][k], ref["per_episode"][k], k in HIGHER_IS_BETTER)
+                for k in keys
+            ]
+            body.append(f"| {name} | " + " | ".join(cells) + " |")
+        if body:
+            lines += [
+                f"**{_label(env_id)}**: controller - `{reference}`",
+                "",
+                "| controller | return | " + " | ".join(keys) + " |",
+                "|---|" + "---:|" * (1 + len(keys)),
+                *body,
+                "",
+            ]
+    return lines
 
 
 def robustness_table(entries: Sequence[dict[str, Any]]) -> list[str]:
     """Markdown lines: each controller's mean return per condition and its change from nominal
-    (who degrades more under stress and on the wrong ship)."""
+    (who degrades more under stress, on the wrong ship, with noisy sensors, with a delay)."""
     conds = list(dict.fromkeys(e["condition"] for e in entries))
     if len(conds) < 2 or "nominal" not in conds:
         return []
     by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
     others = [c for c in conds if c != "nominal"]
     lines = [
-        "Robustness: mean return per condition, and its change from nominal.",
-        "",
         "| env | controller | nominal | " + " | ".join(others) + " |",
         "|---|---|---:|" + "---:|" * len(others),
     ]
     for env_id in dict.fromkeys(e["env"] for e in entries):
         for name in dict.fromkeys(e["controller"] for e in entries if e["env"] == env_id):
             nominal = by_key.get((env_id, name, "nominal"))
-            if nominal is None:
+            if nominal is None or not any((env_id, name, c) in by_key for c in others):
                 continue
             base = nominal["mean_return"]
             cells = []
@@ -46,15 +138,13 @@ def robustness_table(entries: Sequence[dict[str, Any]]) -> list[str]:
                 cells.append(
                     "—" if e is None else f"{e['mean_return']:.3g} ({e['mean_return'] - base:+.3g})"
                 )
-            lines.append(
-                f"| {env_id.split('/')[-1]} | {name} | {base:.3g} | " + " | ".join(cells) + " |"
-            )
+            lines.append(f"| {_label(env_id)} | {name} | {base:.3g} | " + " | ".join(cells) + " |")
     return [*lines, ""]
 
 
-def paired_table(entries: Sequence[dict[str, Any]], reference: str = "classic") -> list[str]:
-    """Markdown lines: each controller's return against ``reference`` on the same seeds (mean
-    paired difference, bootstrap 95 % interval, verdict), nominal and stress."""
+def paired_table(entries: Sequence[dict[str, Any]], reference: str = REFERENCE) -> list[str]:
+    """Markdown lines: each controller's return against ``reference`` on the same seeds in
+    every condition (mean paired difference, bootstrap 95 % interval, verdict)."""
     by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
     rows = []
     for (env_id, name, cond), e in by_key.items():
@@ -65,16 +155,12 @@ def paired_table(entries: Sequence[dict[str, Any]], reference: str = "classic") 
             continue
         mean, lo, hi = paired_difference(e["returns"], ref["returns"])
         rows.append(
-            f"| {env_id.split('/')[-1]} | {cond} | {name} | {mean:+.3g} | "
+            f"| {_label(env_id)} | {cond} | {name} | {mean:+.3g} | "
             f"[{lo:+.3g}, {hi:+.3g}] | {verdict(lo, hi)} |"
         )
     if not rows:
         return []
     return [
-        f"Return against `{reference}` on the same seeds: mean paired difference and its "
-        "bootstrap 95 % interval; a controller is better or worse only where the interval "
-        "excludes zero.",
-        "",
         f"| env | condition | controller | return - {reference} | 95 % interval | verdict |",
         "|---|---|---|---:|---|---|",
         *rows,
@@ -87,9 +173,8 @@ def render_markdown(
     throughput: Sequence[dict[str, Any]] | None,
     figure_dir: str = "docs/benchmark",
 ) -> str:
-    """Markdown: one row per (env, controller), nominal and stress side by side."""
-    envs = list(dict.fromkeys(e["env"] for e in entries))
-    by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
+    """Markdown: the nominal metrics with intervals, the paired comparison with the tuned
+    classic controller, the robustness conditions and the training throughput."""
     first = entries[0]
     stress_speeds = {
         e["env"]: e["options"].get("current_speed") for e in entries if e["condition"] == "stress"
@@ -97,35 +182,42 @@ def render_markdown(
     lines = [
         f"{first['episodes']} episodes per cell, seeds {first['seed']}-"
         f"{first['seed'] + first['episodes'] - 1} (the same initial states, setpoints, paths, "
-        "targets and current directions for every controller), mean ± std over episodes. "
-        "Stress: the current speed fixed at 1.5 x the training maximum ("
-        + ", ".join(f"{e.split('/')[-1]} {s:g} m/s" for e, s in stress_speeds.items() if s)
-        + ").",
+        "targets and current directions for every controller and condition); every mean comes "
+        "with its bootstrap 95 % interval in brackets.",
         "",
-        "| env | controller | return | return, stress | metrics | metrics, stress |",
-        "|---|---|---:|---:|---|---|",
+        "Nominal condition:",
+        "",
+        *metrics_tables(entries),
+        f"![benchmark metrics]({figure_dir}/metrics.png)",
+        "",
     ]
-    for env_id in envs:
-        for name in dict.fromkeys(e["controller"] for e in entries if e["env"] == env_id):
-            cells = []
-            metric_cells = []
-            for cond in ("nominal", "stress"):
-                e = by_key.get((env_id, name, cond))
-                if e is None:
-                    cells.append("—")
-                    metric_cells.append("—")
-                    continue
-                cells.append(_pm(e["mean_return"], e["std_return"]))
-                metric_cells.append(
-                    ", ".join(f"{k} {_pm(v, e['metrics_std'][k])}" for k, v in e["metrics"].items())
-                )
-            lines.append(
-                f"| {env_id.split('/')[-1]} | {name} | {cells[0]} | {cells[1]} | "
-                f"{metric_cells[0]} | {metric_cells[1]} |"
-            )
-    lines += ["", f"![benchmark metrics]({figure_dir}/metrics.png)", ""]
-    lines += robustness_table(entries)
-    lines += paired_table(entries)
+    paired = paired_metrics_tables(entries)
+    if paired:
+        lines += [
+            f"Against `{REFERENCE}`, episode by episode on the same seeds (nominal): the mean "
+            "paired difference and its 95 % interval; **better** or **worse** only where the "
+            "interval excludes zero (return: higher is better; metrics: lower is better but "
+            "for `completed`).",
+            "",
+            *paired,
+        ]
+    robust = robustness_table(entries)
+    if robust:
+        lines += [
+            "Robustness: mean return per condition and its change from nominal. Stress: the "
+            "current speed fixed at 1.5 x the training maximum ("
+            + ", ".join(f"{_label(e)} {s:g} m/s" for e, s in stress_speeds.items() if s)
+            + "); mismatch: the ship named, with gains and agents made for the nominal one; "
+            "noise: sensor noise at its default levels; delay: the actuator commands two "
+            "control steps late.",
+            "",
+            *robust,
+            f"![robustness]({figure_dir}/robustness.png)",
+            "",
+            f"Return against `{REFERENCE}` on the same seeds in every condition:",
+            "",
+            *paired_table(entries),
+        ]
     if throughput:
         lines += [
             "PPO training throughput, the shipped agents' PPO settings (16 sub-envs, "

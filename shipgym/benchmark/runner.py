@@ -1,22 +1,29 @@
-"""The benchmark: every env, every controller, identical scenarios, nominal, stressed and on
-the wrong ship.
+"""The benchmark: every env, every controller, identical scenarios, nominal and under the
+conditions a ship meets: strong current, the wrong ship, noisy sensors, a slow actuator.
 
-:func:`run_benchmark` evaluates the ``classic`` controller, the trained ``ppo`` and ``sac``
-agents and the ``zero`` command with :func:`shipgym.benchmark.evaluate.evaluate` on the same
-seeds (episode ``k`` has seed ``seed + k``: the same initial state, setpoints, path, target and
-current draw for every controller). Three conditions:
+:func:`run_benchmark` evaluates the ``classic`` controller with its design-rule gains and with
+its tuned gains (``classic-tuned``), the trained ``ppo`` and ``sac`` agents and the ``zero``
+command with :func:`shipgym.benchmark.evaluate.evaluate` on the same seeds (episode ``k`` has
+seed ``seed + k``: the same initial state, setpoints, path, target and current draw for every
+controller). Conditions:
 
 * ``nominal``: the env's own current draws (speed uniform in ``[0, max_current_speed]``, the
   range the agents were trained on);
 * ``stress``: the current speed fixed at ``STRESS_FACTOR`` (1.5) times that training maximum,
   with the same seeded directions (no different from nominal for the Nomoto ship: a uniform
   current does not enter its yaw dynamics);
-* ``mismatch``: the same scenarios on a ship the agents and the classic gains were not made for
-  (:data:`MISMATCH_KWARGS`: the nonlinear Bech Mariner instead of the first-order Nomoto one;
-  the sea-trial Gunnerus instead of seed 001's).
+* ``mismatch``: the same scenarios on ships the agents and the classic gains were not made for
+  (:data:`MISMATCH_SHIPS`: the nonlinear Bech and Norrbin Mariners for the first-order Nomoto
+  env; the other Gunnerus parameter set for the Gunnerus envs), one result per ship, labelled
+  ``mismatch:<ship>``;
+* ``noise``: :class:`~shipgym.envs.wrappers.SensorNoise` at its default levels (heading 0.5
+  deg, yaw rate 0.1 deg/s, speed 0.1 m/s, position 1 m);
+* ``delay``: :class:`~shipgym.envs.wrappers.ActuatorDelay` of :data:`ACTUATOR_DELAY_STEPS`
+  control steps (1 s on the Gunnerus, 2 s on the Mariner).
 
-The default first seed, :data:`shipgym.rl.train.BENCHMARK_SEED`, lies outside every agent's
-training and validation seeds; :func:`run_benchmark` checks that against each agent's record.
+The ``zero`` command, a baseline, runs in the nominal condition only. The default first seed,
+:data:`shipgym.rl.train.BENCHMARK_SEED`, lies outside every agent's training and validation
+seeds and the tuning seeds; :func:`run_benchmark` checks that against each agent's record.
 """
 
 from __future__ import annotations
@@ -34,22 +41,64 @@ import gymnasium as gym
 
 from shipgym.benchmark.evaluate import METRICS, EvaluationResult, evaluate
 from shipgym.benchmark.policies import POLICIES, make_policy
-from shipgym.envs import ENV_IDS
+from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS, env_task
+from shipgym.envs.wrappers import ActuatorDelay, SensorNoise
 from shipgym.rl.train import BENCHMARK_SEED
 
-CONTROLLERS = ("classic", "ppo", "sac", "zero")
-CONDITIONS = ("nominal", "stress", "mismatch")
+CONTROLLERS = ("classic", "classic-tuned", "ppo", "sac", "zero")
+CONDITIONS = ("nominal", "stress", "mismatch", "noise", "delay")
+#: Controllers run in the nominal condition only (baselines).
+NOMINAL_ONLY = ("zero",)
 #: Stress condition: current speed as a multiple of the training maximum.
 STRESS_FACTOR = 1.5
-#: Model-mismatch condition: the ship the agents and gains were not made for (the nonlinear
-#: Bech Mariner for the first-order Nomoto env; the sea-trial Gunnerus for the seed-001 one).
-MISMATCH_KWARGS: dict[str, dict[str, Any]] = {
-    "shipgym/NomotoHeading-v0": {"model": "bech"},
-    "shipgym/RVGHeading-v0": {"params": "sea_trials"},
-    "shipgym/RVGSpeed-v0": {"params": "sea_trials"},
-    "shipgym/RVGPathFollowing-v0": {"params": "sea_trials"},
-    "shipgym/RVGTargetTracking-v0": {"params": "sea_trials"},
+#: Actuator-delay condition: the delay in control steps of the env.
+ACTUATOR_DELAY_STEPS = 2
+#: Model-mismatch condition: the ships the agents and gains were not made for, by label (the
+#: nonlinear Bech and Norrbin Mariners for the first-order Nomoto env; for the Gunnerus envs
+#: the other parameter set: seed 001's for the sea-trial ship of ``-v1``, the sea-trial ship
+#: for ``-v0``).
+MISMATCH_SHIPS: dict[str, dict[str, dict[str, Any]]] = {
+    env_id: (
+        {"bech": {"model": "bech"}, "norrbin": {"model": "norrbin"}}
+        if env_task(env_id) == "NomotoHeading"
+        else {"seed001": {"params": "seed001"}}
+        if env_id.endswith("-v1")
+        else {"sea_trials": {"params": "sea_trials"}}
+    )
+    for env_id in ENV_IDS
 }
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One condition of one env as :func:`evaluate` runs it."""
+
+    label: str
+    env_kwargs: dict[str, Any] | None = None
+    reset_options: dict[str, Any] | None = None
+    wrappers: tuple[Callable[[gym.Env], gym.Env], ...] = ()
+
+
+def scenarios(env_id: str, condition: str, stress_current: float) -> list[Scenario]:
+    """The scenarios of ``condition`` on ``env_id`` (one per mismatched ship)."""
+    if condition == "nominal":
+        return [Scenario("nominal")]
+    if condition == "stress":
+        return [Scenario("stress", reset_options={"current_speed": stress_current})]
+    if condition == "mismatch":
+        return [
+            Scenario(f"mismatch:{label}", env_kwargs=kwargs)
+            for label, kwargs in MISMATCH_SHIPS[env_id].items()
+        ]
+    if condition == "noise":
+        return [Scenario("noise", wrappers=(SensorNoise,))]
+    if condition == "delay":
+
+        def delayed(env: gym.Env) -> gym.Env:
+            return ActuatorDelay(env, ACTUATOR_DELAY_STEPS * env.unwrapped.dt)
+
+        return [Scenario("delay", wrappers=(delayed,))]
+    raise ValueError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
 
 
 @dataclass
@@ -111,9 +160,10 @@ class BenchmarkResult:
         return rows
 
     def write_json(self, path: str | Path) -> Path:
-        """Write :meth:`to_list` as JSON."""
+        """Write :meth:`to_list` as JSON, one evaluation per line (the per-episode values
+        make an indented file needlessly long)."""
         path = Path(path)
-        path.write_text(json.dumps(self.to_list(), indent=2) + "\n")
+        path.write_text("[\n" + ",\n".join(json.dumps(d) for d in self.to_list()) + "\n]\n")
         return path
 
     def write_csv(self, path: str | Path) -> Path:
@@ -142,9 +192,11 @@ class BenchmarkResult:
             keys = ("return", *METRICS[env_id])
             header = ["controller", "condition", *keys]
             body = [
-                [name, cond] + [_cell(self.get(env_id, name, cond), key) for key in keys]
+                [r.controller, r.condition] + [_cell(r, key) for key in keys]
                 for name in controllers
                 for cond in conditions
+                for r in self.results
+                if (r.env, r.controller, r.condition) == (env_id, name, cond)
             ]
             widths = [max(len(r[i]) for r in [header, *body]) for i in range(len(header))]
             for r in [header, *body]:
@@ -171,13 +223,17 @@ def training_max_current(env_id: str) -> float:
 
 
 def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None:
-    """Raise ``ValueError`` if ``[seed, seed + episodes)`` meets an agent's own seeds."""
-    for key in ("training_seeds", "validation_seeds"):
+    """Raise ``ValueError`` if ``[seed, seed + episodes)`` meets the seeds an agent was
+    trained or selected on, or the seeds tuned gains were chosen on (``*_seeds`` entries of
+    ``meta``)."""
+    for key in ("training_seeds", "validation_seeds", "tuning_seeds"):
+        if key not in meta:
+            continue
         lo, hi = meta[key]
         if seed <= hi and lo <= seed + episodes - 1:
             raise ValueError(
                 f"evaluation seeds {seed}..{seed + episodes - 1} overlap the {key.split('_')[0]} "
-                f"seeds {lo}..{hi} of agent {meta['name']}; choose a first seed outside them "
+                f"seeds {lo}..{hi} of {meta['name']}; choose a first seed outside them "
                 f"(the default {BENCHMARK_SEED} is)"
             )
 
@@ -185,7 +241,7 @@ def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None
 def run_benchmark(
     episodes: int = 100,
     seed: int = BENCHMARK_SEED,
-    envs: Sequence[str] = ENV_IDS,
+    envs: Sequence[str] = CURRENT_ENV_IDS,
     controllers: Sequence[str] = CONTROLLERS,
     conditions: Sequence[str] = CONDITIONS,
     agents_dir: str | Path | None = None,
@@ -236,34 +292,48 @@ def run_benchmark(
                 agents[policy.meta["name"]] = {
                     k: policy.meta[k] for k in ("env", "algo", "timesteps", "seed", "wall_time_s")
                 }
+            if name == "classic-tuned":
+                from shipgym.benchmark.tuning import load_tuned
+
+                tuned = load_tuned(env_id)
+                check_seeds_disjoint(
+                    {"name": f"{env_id} classic-tuned", "tuning_seeds": tuned["seeds"]},
+                    seed,
+                    episodes,
+                )
             policies[env_id, name] = policy
     stress_current = {env_id: STRESS_FACTOR * training_max_current(env_id) for env_id in envs}
+    cells = [
+        (env_id, scenario, name)
+        for env_id in envs
+        for condition in conditions
+        for scenario in scenarios(env_id, condition, stress_current[env_id])
+        for name in controllers
+        if scenario.label == "nominal" or name not in NOMINAL_ONLY
+    ]
     results = []
-    total = len(envs) * len(controllers) * len(conditions)
-    for env_id in envs:
-        for condition in conditions:
-            options = {"current_speed": stress_current[env_id]} if condition == "stress" else None
-            env_kwargs = MISMATCH_KWARGS[env_id] if condition == "mismatch" else None
-            for name in controllers:
-                t0 = time.perf_counter()
-                result = evaluate(
-                    env_id,
-                    policies[env_id, name],
-                    name,
-                    episodes=episodes,
-                    seed=seed,
-                    env_kwargs=env_kwargs,
-                    reset_options=options,
-                    progress=lambda line: None,
-                    condition=condition,
-                )
-                results.append(result)
-                d = result.to_dict()
-                progress(
-                    f"[{len(results)}/{total}] {env_id} {name} {condition}: return "
-                    f"{d['mean_return']:.1f} +- {d['std_return']:.1f} "
-                    f"({time.perf_counter() - t0:.1f} s)"
-                )
+    total = len(cells)
+    for env_id, scenario, name in cells:
+        t0 = time.perf_counter()
+        result = evaluate(
+            env_id,
+            policies[env_id, name],
+            name,
+            episodes=episodes,
+            seed=seed,
+            env_kwargs=scenario.env_kwargs,
+            reset_options=scenario.reset_options,
+            progress=lambda line: None,
+            condition=scenario.label,
+            wrappers=scenario.wrappers,
+        )
+        results.append(result)
+        d = result.to_dict()
+        progress(
+            f"[{len(results)}/{total}] {env_id} {name} {scenario.label}: return "
+            f"{d['mean_return']:.1f} +- {d['std_return']:.1f} "
+            f"({time.perf_counter() - t0:.1f} s)"
+        )
     return BenchmarkResult(
         results=results,
         episodes=episodes,

@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from shipgym.envs import ENV_IDS
+from shipgym.envs import CURRENT_ENV_IDS
 
 CARTPOLE = "CartPole-v1"
 #: PPO steps/s on a shipgym env relative to CartPole-v1 that counts as "not the bottleneck".
@@ -63,7 +63,7 @@ def ppo_steps_per_second(env_id: str, timesteps: int, seed: int = 0) -> float:
 
 
 def ppo_throughput(
-    env_ids: Sequence[str] = ENV_IDS,
+    env_ids: Sequence[str] = CURRENT_ENV_IDS,
     timesteps: int = 16_384,
     repeats: int = 2,
     progress: Callable[[str], None] | None = None,

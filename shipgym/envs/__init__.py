@@ -7,6 +7,11 @@
 | ``shipgym/RVGSpeed-v0`` | hold speed setpoints (Gunnerus) | pod thrust |
 | ``shipgym/RVGPathFollowing-v0`` | follow waypoints (Gunnerus) | azimuth, thrust |
 | ``shipgym/RVGTargetTracking-v0`` | intercept and hold distance (Gunnerus) | azimuth, thrust |
+
+Each ``RVG*`` env also has a ``-v1`` id: the same task on the Gunnerus identified from its sea
+trials (``params="sea_trials"``, :meth:`shipgym.models.RVGParams.sea_trials`) by default. The
+``-v0`` ids keep seed 001's parameters, unchanged. :data:`CURRENT_ENV_IDS` lists the newest
+version of every task: the envs the benchmark and the shipped agents use.
 """
 
 from __future__ import annotations
@@ -23,13 +28,34 @@ from shipgym.envs.path_following import RVGPathFollowingEnv, RVGPathFollowingVec
 from shipgym.envs.speed import RVGSpeedEnv, RVGSpeedVectorEnv
 from shipgym.envs.target_tracking import RVGTargetTrackingEnv, RVGTargetTrackingVectorEnv
 
-ENV_IDS = (
-    "shipgym/NomotoHeading-v0",
-    "shipgym/RVGHeading-v0",
-    "shipgym/RVGSpeed-v0",
-    "shipgym/RVGPathFollowing-v0",
-    "shipgym/RVGTargetTracking-v0",
-)
+#: The tasks, in the order of every table.
+TASKS = ("NomotoHeading", "RVGHeading", "RVGSpeed", "RVGPathFollowing", "RVGTargetTracking")
+
+#: Default keyword arguments per env version (``-v1``: the validated sea-trial Gunnerus).
+_VERSIONS: dict[str, dict[str, dict[str, object]]] = {
+    "NomotoHeading": {"v0": {}},
+    **{task: {"v0": {}, "v1": {"params": "sea_trials"}} for task in TASKS[1:]},
+}
+
+#: Every registered env id.
+ENV_IDS = tuple(f"shipgym/{task}-{v}" for task in TASKS for v in _VERSIONS[task])
+#: The newest version of each task: what the benchmark, the shipped agents and
+#: ``shipgym bench`` use by default.
+CURRENT_ENV_IDS = tuple(f"shipgym/{task}-{max(_VERSIONS[task])}" for task in TASKS)
+
+
+def env_task(env_id: str) -> str:
+    """The task of a registered env id (``"shipgym/RVGHeading-v1"`` -> ``"RVGHeading"``).
+
+    Raises
+    ------
+    ValueError
+        If ``env_id`` is not one of :data:`ENV_IDS`.
+    """
+    if env_id not in ENV_IDS:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    return env_id.split("/", 1)[1].rsplit("-", 1)[0]
+
 
 _CLASSES = (
     (NomotoHeadingEnv, NomotoHeadingVectorEnv),
@@ -42,19 +68,24 @@ _CLASSES = (
 
 def register_envs() -> None:
     """Register every shipgym environment with Gymnasium (idempotent)."""
-    for env_id, (single, vector) in zip(ENV_IDS, _CLASSES, strict=True):
-        if env_id in registry:
-            continue
-        register(
-            id=env_id,
-            entry_point=f"{single.__module__}:{single.__name__}",
-            vector_entry_point=f"{vector.__module__}:{vector.__name__}",
-            max_episode_steps=single.task_cls.max_episode_steps,
-        )
+    for task, (single, vector) in zip(TASKS, _CLASSES, strict=True):
+        for version, kwargs in _VERSIONS[task].items():
+            env_id = f"shipgym/{task}-{version}"
+            if env_id in registry:
+                continue
+            register(
+                id=env_id,
+                entry_point=f"{single.__module__}:{single.__name__}",
+                vector_entry_point=f"{vector.__module__}:{vector.__name__}",
+                max_episode_steps=single.task_cls.max_episode_steps,
+                kwargs=dict(kwargs),
+            )
 
 
 __all__ = [
+    "CURRENT_ENV_IDS",
     "ENV_IDS",
+    "TASKS",
     "NomotoHeadingEnv",
     "NomotoHeadingVectorEnv",
     "RVGHeadingEnv",
@@ -65,5 +96,6 @@ __all__ = [
     "RVGSpeedVectorEnv",
     "RVGTargetTrackingEnv",
     "RVGTargetTrackingVectorEnv",
+    "env_task",
     "register_envs",
 ]

@@ -226,6 +226,28 @@ class Task:
         self._reset_task(rows, task_draws, options)
         self._kernel(rows.size)(*self._args(False, rows))
 
+    def observe(self, states: np.ndarray) -> np.ndarray:
+        """The observations of every row if its state were ``states`` (``(n, nx)``).
+
+        The task's own kernel computes them (its observation pass, as at reset), so a
+        measured state with sensor errors gives exactly the observation a ship with those
+        errors would form. Nothing of the task changes: state, rewards, flags and task
+        quantities (the active path segment) are restored.
+        """
+        states = np.asarray(states, dtype=np.float64)
+        if states.shape != self.x.shape:
+            raise ValueError(f"states must have shape {self.x.shape}, got {states.shape}")
+        kept = [self.x, self.obs, self.rew, self.term, self.reason]
+        kept += [a for a in self._kernel_args() if isinstance(a, np.ndarray)]
+        saved = [a.copy() for a in kept]
+        try:
+            self.x[:] = states
+            self._kernel(self.n)(*self._args(False, np.arange(self.n)))
+            return self.obs.copy()
+        finally:
+            for a, old in zip(kept, saved, strict=True):
+                a[...] = old
+
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
         """Raise ``ValueError`` for a bad task option before anything is changed."""
 

@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from shipgym.envs import ENV_IDS
+from shipgym.envs import CURRENT_ENV_IDS
 from shipgym.rl.train import ALGOS, VALIDATION_SEED
 
 README_MARKER = "training"
@@ -27,7 +27,7 @@ _COLOURS = {"ppo": "#c0392b", "sac": "#2e8b57"}
 def training_rows(agent_dir: str | Path) -> list[dict[str, Any]]:
     """One row per agent record found in ``agent_dir`` (env order, then algorithm)."""
     rows = []
-    for env_id in ENV_IDS:
+    for env_id in CURRENT_ENV_IDS:
         for algo in ALGOS:
             path = Path(agent_dir) / f"{env_id.split('/')[-1]}-{algo}.json"
             if path.is_file():
@@ -71,7 +71,7 @@ def plot_learning_curves(
     rows: list[dict[str, Any]], classic: dict[str, float], path: str | Path
 ) -> Path:
     """Validation return against env steps, one panel per env, PPO and SAC overlaid."""
-    envs = [e for e in ENV_IDS if any(r["env"] == e for r in rows)]
+    envs = [e for e in CURRENT_ENV_IDS if any(r["env"] == e for r in rows)]
     fig = Figure(figsize=(3.6 * len(envs), 3.4), constrained_layout=True)
     FigureCanvasAgg(fig)
     axes = np.atleast_1d(fig.subplots(1, len(envs), squeeze=False)[0])
