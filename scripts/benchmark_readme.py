@@ -2,8 +2,11 @@
 
     python scripts/benchmark_readme.py [extra shipgym benchmark arguments]
 
-The block between ``<!-- benchmark -->`` and ``<!-- /benchmark -->`` gets the table (nominal
-and stress for every env and controller), the throughput table and the figures.
+The block between ``<!-- benchmark -->`` and ``<!-- /benchmark -->`` gets the tables (nominal
+metrics with intervals, paired comparisons, robustness), the throughput table and the figures.
+It also runs the model mismatch the other way round: the ``-v0`` Gunnerus envs, whose agents
+and design-rule gains were made on seed 001's parameters, on the sea-trial ship
+(``docs/benchmark/reverse.json``).
 """
 
 from __future__ import annotations
@@ -12,11 +15,15 @@ import json
 import sys
 from pathlib import Path
 
-from shipgym.benchmark.report import README_MARKER, render_markdown
+from shipgym.benchmark.report import README_MARKER, render_markdown, robustness_table
+from shipgym.benchmark.runner import run_benchmark
 from shipgym.cli import main as shipgym
+from shipgym.envs import ENV_IDS
 from shipgym.sysid.report import update_readme
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The Gunnerus envs whose agents were trained on seed 001's parameters.
+SEED001_ENVS = tuple(e for e in ENV_IDS if e.startswith("shipgym/RVG") and e.endswith("-v0"))
 
 
 def main(argv: list[str]) -> int:
@@ -25,9 +32,19 @@ def main(argv: list[str]) -> int:
     if code:
         return code
     entries = json.loads((out / "benchmark.json").read_text())
+    reverse = run_benchmark(
+        envs=SEED001_ENVS, controllers=("classic", "ppo", "sac"), conditions=("nominal", "mismatch")
+    )
+    reverse.write_json(out / "reverse.json")
     throughput_path = out / "throughput.json"
     throughput = json.loads(throughput_path.read_text()) if throughput_path.is_file() else None
-    update_readme(ROOT / "README.md", render_markdown(entries, throughput), README_MARKER)
+    block = render_markdown(entries, throughput)
+    block += (
+        "\n\nThe other way round: the `-v0` envs, whose agents and design-rule gains were made "
+        "on seed 001's parameters, on the sea-trial ship (same seeds):\n\n"
+        + "\n".join(robustness_table(reverse.to_list()))
+    )
+    update_readme(ROOT / "README.md", block, README_MARKER)
     print(f"wrote the README block {README_MARKER!r}")
     return 0
 

@@ -14,6 +14,7 @@ import shipgym
 from shipgym.benchmark import evaluate, make_policy
 from shipgym.benchmark.policies import CLASSIC, classic_policy
 from shipgym.benchmark.tuning import (
+    BOUNDS,
     SEARCH,
     _beyond_edge,
     candidates,
@@ -42,8 +43,13 @@ def test_grid_and_edge_steps() -> None:
     assert _beyond_edge((0.1, 0.2, 0.4), 0.2) is None
     assert _beyond_edge((None, 0.2, 0.4), None) is None  # the design rule
     assert _beyond_edge((1.0, 2.0, 0.0), 0.0) is None  # "off"
-    for task, grid in SEARCH.items():  # every searched name is a design parameter
+    assert _beyond_edge((0.1, 0.2), 0.2, (0.0, 0.3)) == pytest.approx(0.3)  # held at the bound
+    assert _beyond_edge((0.1, 0.3), 0.3, (0.0, 0.3)) is None
+    for task, grid in SEARCH.items():  # every searched name is a design parameter, in bounds
         assert set(grid) <= set(CLASSIC[task].DESIGN)
+        for name, values in grid.items():
+            lo, hi = BOUNDS[name]
+            assert all(lo <= v <= hi for v in values if v is not None and v != 0)
 
 
 def test_tune_picks_the_best_candidate_and_records_it(tmp_path: Path) -> None:
@@ -85,10 +91,10 @@ def test_missing_or_foreign_records_are_clear_errors(tmp_path: Path) -> None:
         load_tuned(HEADING, tmp_path)
     path = tuned_path(HEADING, tmp_path)
     path.write_text(json.dumps({"env": HEADING, "design": {"lookahead_lengths": 3.0}}))
-    with pytest.raises(ValueError, match="design parameters among"):
+    with pytest.raises(ValueError, match="unknown design parameter"):
         load_tuned(HEADING, tmp_path)
     path.write_text(json.dumps({"env": HEADING, "design": {"omega_n": "fast"}}))
-    with pytest.raises(ValueError, match="not a finite number"):
+    with pytest.raises(ValueError, match="omega_n must be a finite number"):
         load_tuned(HEADING, tmp_path)
 
 
@@ -104,9 +110,16 @@ def test_shipped_tuned_gains_and_their_record(env_id: str) -> None:
     assert record["budget"]["episodes"] == record["budget"]["candidates"] * record["episodes"]
     best = max(record["candidates"], key=lambda r: r["mean_return"])
     assert record["score"] == best["mean_return"]
-    # no winner left on an edge the search could step past, unless stepping lost
+    # no winner left on an edge the search could step past, unless stepping lost; every
+    # candidate within the engineering limits
     for name, values in record["grid"].items():
-        beyond = _beyond_edge(values, record["design"][name])
+        lo, hi = BOUNDS[name]
+        assert all(
+            lo <= r["design"][name] <= hi
+            for r in record["candidates"]
+            if r["design"][name] is not None and r["design"][name] != 0
+        )
+        beyond = _beyond_edge(values, record["design"][name], BOUNDS[name])
         if beyond is not None:
             tried = [r for r in record["candidates"] if r["design"][name] == pytest.approx(beyond)]
             assert tried and all(r["mean_return"] <= record["score"] for r in tried)

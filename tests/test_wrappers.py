@@ -89,7 +89,7 @@ def test_noise_is_seeded_by_the_episode() -> None:
     assert not np.array_equal(oa, oc)
     with pytest.raises(ValueError, match="unknown noise channel"):
         SensorNoise(gym.make(HEADING), gps=1.0)
-    with pytest.raises(ValueError, match="heading must be a finite number >= 0"):
+    with pytest.raises(ValueError, match="heading must be >= 0"):
         SensorNoise(gym.make(HEADING), heading=-1.0)
 
 
@@ -119,7 +119,7 @@ def test_delay_applies_each_command_k_steps_late(env_id: str) -> None:
 
 
 def test_delay_checks_its_input() -> None:
-    with pytest.raises(ValueError, match="delay must be a finite number >= 0"):
+    with pytest.raises(ValueError, match="'delay' must be finite"):
         ActuatorDelay(gym.make(HEADING), delay=math.nan)
     env = ActuatorDelay(gym.make(HEADING), delay=1.0)
     env.reset(seed=0)

@@ -31,7 +31,8 @@ agents the same way. Its few design parameters (:attr:`DESIGN` of each class) co
   rad/s, 0.04 rad/s) so the heading loop stays inside the guidance loop, speed autopilot at
   the service speed.
 * RVGTargetTracking: constant-bearing guidance (seed 004 eq. 11) with an approach speed of 2
-  m/s and ``Delta`` 100 m, heading autopilot with the step reference.
+  m/s and ``Delta`` 100 m, heading autopilot with the step reference, and a thrust floor of a
+  quarter of the service thrust (the pods steer with their thrust).
 
 ``classic-tuned``: the same structures with design parameters chosen by a grid search on the
 RL training seeds (:mod:`shipgym.benchmark.tuning`); the chosen values and the search's record
@@ -144,10 +145,16 @@ def _rvg_heading_autopilot(
 
 
 def _rvg_speed_autopilot(
-    dt: float, params: str, omega_n: float, zeta: float, design_speed: float = 4.0
+    dt: float,
+    params: str,
+    omega_n: float,
+    zeta: float,
+    design_speed: float = 4.0,
+    min_thrust: float = 0.0,
 ) -> SpeedAutopilot:
     """PI on each pod's thrust with the nominal ship's resistance as feed-forward; the
-    design model is the surge dynamics linearised at ``design_speed``."""
+    design model is the surge dynamics linearised at ``design_speed``. ``min_thrust`` is the
+    least thrust commanded, as a fraction of the service thrust."""
     p = RVGParams.named(params)
     mass = p.mass + p.added_mass[0, 0]
     h = 1e-3 * design_speed
@@ -164,7 +171,7 @@ def _rvg_speed_autopilot(
         omega_n=omega_n,
         zeta=zeta,
         feedforward=lambda u: _rvg_thrust(p, u),
-        min_command=0.0,
+        min_command=min_thrust * p.service_thrust,
         max_command=p.max_thrust,
     )
 
@@ -358,13 +365,16 @@ class RVGTargetClassic(ClassicPolicy):
 
     The guidance gives a course and a speed over ground; the heading setpoint is that course
     minus the measured crab angle, and the speed autopilot holds the speed over ground.
-    Design parameters: ``approach_speed`` (``U_a,max`` [m/s]), ``delta`` (``Delta`` [m]), and
-    the heading loop's ``omega_n``, ``reference_omega``, ``max_turn_rate``.
+    Design parameters: ``approach_speed`` (``U_a,max`` [m/s]), ``delta`` (``Delta`` [m]),
+    ``min_thrust`` (the least thrust the speed loop commands, a fraction of the service
+    thrust: azimuth pods steer with their thrust, so a ship slowing down to its target keeps
+    some to turn with) and the heading loop's ``omega_n``, ``reference_omega``,
+    ``max_turn_rate``.
     """
 
     DESIGN: ClassVar[dict[str, float | None]] = {
-        "approach_speed": 2.0, "delta": 100.0, "omega_n": None, "reference_omega": 0.1,
-        "max_turn_rate": 0.03,
+        "approach_speed": 2.0, "delta": 100.0, "min_thrust": 0.25, "omega_n": None,
+        "reference_omega": 0.1, "max_turn_rate": 0.03,
     }  # fmt: skip
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
@@ -376,10 +386,12 @@ class RVGTargetClassic(ClassicPolicy):
             d.pop("approach_speed"), d.pop("delta"), float(task.distance[0]), max_speed=6.0,
             dt=env.dt,
         )  # fmt: skip
+        min_thrust = d.pop("min_thrust")
         self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, self.nominal, **d)
         self.speed = _rvg_speed_autopilot(
-            env.dt, self.nominal, **RVGSpeedClassic.DESIGN, design_speed=3.0
-        )
+            env.dt, self.nominal, **RVGSpeedClassic.DESIGN, design_speed=3.0,
+            min_thrust=min_thrust,
+        )  # fmt: skip
         state = _measured(info)
         self.heading.reset(state[2], state[IR], t=0.0)
         self.speed.reset(t=0.0)

@@ -8,9 +8,10 @@ closed loop does what is asked. :func:`tune` does that for the classic policy of
 of the **RL training seeds** (``seed .. seed + episodes - 1``, 0-15 by default: the seeds the
 agents' sub-envs are trained on, disjoint from the validation and benchmark seeds), on the
 env's nominal ship, and the combination with the best mean return wins; where it lies on the
-edge of the grid, the search steps past that edge while the return improves. The record keeps every
-candidate's score, the design-rule candidate's, and the budget in episodes and env steps, to
-set beside the agents' training budgets (2-3 million env steps for PPO).
+edge of the grid, the search steps past that edge while the return improves, within the
+engineering limits of :data:`BOUNDS`. The record keeps every candidate's score, the design-rule
+candidate's, and the budget in episodes and env steps, to set beside the agents' training
+budgets (2-3 million env steps for PPO).
 
 The shipped records live in ``shipgym/benchmark/tuned/<env>.json`` (one per env of
 :data:`shipgym.envs.CURRENT_ENV_IDS`); ``make_policy("classic-tuned", env_id)`` reads them.
@@ -42,6 +43,21 @@ TUNING_SEED = 0
 
 #: Steps past the grid's edge, at most, when the best candidate lies on it.
 MAX_EDGE_STEPS = 4
+#: Engineering limits the search never steps past: a lookahead of at least one ship length
+#: (Fossen recommends 1.5-2.5; shorter, LOS chases its own cross-track noise), loop and
+#: reference-model frequencies of at most 1.5 rad/s (the pods slew 35 deg in 3.5 s), a
+#: turn-rate limit of at most 0.2 rad/s (four times the Gunnerus's steady turning rate at full
+#: azimuth, 0.05 rad/s: no limit at all), approach speeds up to the guidance's 6 m/s.
+BOUNDS: dict[str, tuple[float, float]] = {
+    "lookahead_lengths": (1.0, 10.0),
+    "omega_n": (0.01, 1.5),
+    "reference_omega": (0.01, 1.5),
+    "max_turn_rate": (0.01, 0.2),
+    "approach_speed": (0.5, 6.0),
+    "zeta": (0.4, 2.0),
+    "reference_ratio": (0.5, 8.0),
+    "min_thrust": (0.0, 1.0),
+}
 
 #: The grid searched per task: design parameter -> candidate values (``None``: the design
 #: rule's value). Every other design parameter keeps its design-rule value.
@@ -68,7 +84,7 @@ SEARCH: dict[str, dict[str, tuple[float | None, ...]]] = {
     },
     "RVGTargetTracking": {
         "approach_speed": (2.0, 3.0, 4.0, 5.0, 6.0),
-        "delta": (100.0, 300.0),
+        "min_thrust": (0.0, 0.25, 0.5),
         "omega_n": (None, 0.5),
         "reference_omega": (0.1, 0.3),
         "max_turn_rate": (0.03, 0.08),
@@ -170,7 +186,7 @@ def tune(
     for _ in range(MAX_EDGE_STEPS):
         improved = False
         for name, values in grid.items():
-            beyond = _beyond_edge(values, best["design"][name])
+            beyond = _beyond_edge(values, best["design"][name], BOUNDS.get(name, (0, math.inf)))
             if beyond is None:
                 continue
             row = score({**best["design"], name: beyond}, "edge")
@@ -199,18 +215,24 @@ def tune(
     }
 
 
-def _beyond_edge(values: Sequence[float | None], value: float | None) -> float | None:
+def _beyond_edge(
+    values: Sequence[float | None],
+    value: float | None,
+    bounds: tuple[float, float] = (0.0, math.inf),
+) -> float | None:
     """The next value past the end of ``values`` that ``value`` sits on (geometric step of the
-    last two values), or ``None`` if ``value`` is inside the grid, is ``None`` (the design
-    rule) or 0 (off)."""
+    last two values, held within ``bounds``), or ``None`` if ``value`` is inside the grid, is
+    ``None`` (the design rule), is 0 (off) or already at the bound."""
     grid = sorted(v for v in values if v is not None and v > 0)
     if value is None or value <= 0 or len(grid) < 2:
         return None
     if value >= grid[-1]:
-        return value * grid[-1] / grid[-2]
-    if value <= grid[0]:
-        return value * grid[0] / grid[1]
-    return None
+        nxt = min(value * grid[-1] / grid[-2], bounds[1])
+    elif value <= grid[0]:
+        nxt = max(value * grid[0] / grid[1], bounds[0])
+    else:
+        return None
+    return None if math.isclose(nxt, value) or nxt == value else nxt
 
 
 def _fmt(value: float | None) -> str:
@@ -250,19 +272,17 @@ def load_tuned(env_id: str, directory: str | Path | None = None) -> dict[str, An
         )
     record = json.loads(path.read_text())
     design = record.get("design")
-    known = CLASSIC[env_task(env_id)].DESIGN
-    if record.get("env") != env_id or not isinstance(design, dict) or set(design) - set(known):
-        raise ValueError(
-            f"{path}: not a tuned-gains record of {env_id} with design parameters among "
-            f"{sorted(known)}"
-        )
-    for key, value in design.items():
-        if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value)):
-            raise ValueError(f"{path}: design parameter {key} = {value!r} is not a finite number")
+    if record.get("env") != env_id or not isinstance(design, dict):
+        raise ValueError(f"{path}: not a tuned-gains record of {env_id} (no 'env' and 'design')")
+    try:
+        classic_policy(env_id, **design)  # the policy checks every name and value
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {exc}") from None
     return record
 
 
 __all__ = [
+    "BOUNDS",
     "SEARCH",
     "TUNED_DIR",
     "TUNING_EPISODES",

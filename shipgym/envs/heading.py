@@ -137,13 +137,15 @@ class RVGHeadingEnv(ShipEnv):
     ``gymnasium.make("shipgym/RVGHeading-v0", max_current_speed=0.5, max_azimuth=0.61,
     setpoint_interval=100.0, params="seed001", render_mode=None)``. Reset options and
     ``info`` as for ``NomotoHeading-v0``.
-    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
-    trials) or an ``RVGParams``.
+    trials, the default of ``-v1``) or an ``RVGParams``.
 
     ## Version History
 
     * v0: Initial version.
+    * v1: R/V Gunnerus identified from its sea trials (``params="sea_trials"``) by default;
+      the task, observations and rewards are those of v0.
     """
 
     task_cls = RVGHeadingTask

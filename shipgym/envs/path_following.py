@@ -66,13 +66,15 @@ class RVGPathFollowingEnv(ShipEnv):
     ``current_speed``, ``current_direction``, ``initial_state``, ``waypoints`` (2 to 16
     (north, east) points [m]). ``info`` holds ``state``, the current, ``cross_track_error``,
     ``segment``, ``completed`` and ``termination_reason``.
-    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
-    trials) or an ``RVGParams``.
+    trials, the default of ``-v1``) or an ``RVGParams``.
 
     ## Version History
 
     * v0: Initial version.
+    * v1: R/V Gunnerus identified from its sea trials (``params="sea_trials"``) by default;
+      the task, observations and rewards are those of v0.
     """
 
     task_cls = RVGPathTask

@@ -53,13 +53,15 @@ class RVGSpeedEnv(ShipEnv):
     ``current_direction``,
     ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s] >= 0). ``info`` holds ``state``,
     the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.
-    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default),
+    ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
-    trials) or an ``RVGParams``.
+    trials, the default of ``-v1``) or an ``RVGParams``.
 
     ## Version History
 
     * v0: Initial version.
+    * v1: R/V Gunnerus identified from its sea trials (``params="sea_trials"``) by default;
+      the task, observations and rewards are those of v0.
     """
 
     task_cls = RVGSpeedTask

@@ -29,6 +29,8 @@ from typing import Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
+from shipgym.envs.tasks import _finite_float
+
 #: Default sensor noise, one standard deviation per control step: heading [rad], yaw rate
 #: [rad/s], speed [m/s], position [m].
 SENSOR_NOISE: dict[str, float] = {
@@ -47,12 +49,9 @@ _CHANNELS = {
 
 
 def _nonnegative(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        v = math.nan
-    if not (math.isfinite(v) and v >= 0):
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    v = _finite_float(name, value)
+    if v < 0:
+        raise ValueError(f"{name} must be >= 0, got {value!r}")
     return v
 
 

@@ -35,14 +35,15 @@ def training_rows(agent_dir: str | Path) -> list[dict[str, Any]]:
     return rows
 
 
-def classic_validation_return(env_id: str, episodes: int) -> float:
-    """Mean return of the classic controller on the validation episodes of the training."""
+def classic_validation_return(env_id: str, episodes: int, controller: str = "classic") -> float:
+    """Mean return of a classic controller (``classic`` or ``classic-tuned``) on the
+    validation episodes of the training."""
     from shipgym.benchmark import evaluate, make_policy
 
     result = evaluate(
         env_id,
-        make_policy("classic", env_id),
-        "classic",
+        make_policy(controller, env_id),
+        controller,
         episodes,
         VALIDATION_SEED,
         progress=lambda line: None,
@@ -68,9 +69,10 @@ def render_training_table(rows: list[dict[str, Any]]) -> str:
 
 
 def plot_learning_curves(
-    rows: list[dict[str, Any]], classic: dict[str, float], path: str | Path
+    rows: list[dict[str, Any]], classic: dict[str, dict[str, float]], path: str | Path
 ) -> Path:
-    """Validation return against env steps, one panel per env, PPO and SAC overlaid."""
+    """Validation return against env steps, one panel per env, PPO and SAC overlaid, with the
+    classic controllers' validation returns (``classic[controller][env_id]``) as lines."""
     envs = [e for e in CURRENT_ENV_IDS if any(r["env"] == e for r in rows)]
     fig = Figure(figsize=(3.6 * len(envs), 3.4), constrained_layout=True)
     FigureCanvasAgg(fig)
@@ -88,8 +90,9 @@ def plot_learning_curves(
             ax.fill_between(t, m - s, m + s, color=colour, alpha=0.15)
             if r.get("best_timestep") is not None:
                 ax.plot(r["best_timestep"], r["best_validation_return"], "*", color=colour, ms=9)
-        if env_id in classic:
-            ax.axhline(classic[env_id], color="#1f5fa8", ls="--", lw=1.2, label="classic")
+        for name, colour in (("classic", "#7fa7d6"), ("classic-tuned", "#1f5fa8")):
+            if env_id in classic.get(name, {}):
+                ax.axhline(classic[name][env_id], color=colour, ls="--", lw=1.2, label=name)
         ax.set_xscale("log")
         ax.set_title(env_id.split("/")[-1], fontsize=10)
         ax.set_xlabel("env steps")
@@ -117,8 +120,11 @@ def write_training_report(agent_dir: str | Path, root: str | Path) -> list[Path]
         zip_path = Path(agent_dir) / f"{r['name']}.zip"
         r["file_kb"] = round(zip_path.stat().st_size / 1024) if zip_path.is_file() else None
     classic = {
-        env_id: classic_validation_return(env_id, 16)
-        for env_id in dict.fromkeys(r["env"] for r in rows)
+        name: {
+            env_id: classic_validation_return(env_id, 16, name)
+            for env_id in dict.fromkeys(r["env"] for r in rows)
+        }
+        for name in ("classic", "classic-tuned")
     }
     docs = Path(root) / "docs"
     docs.mkdir(parents=True, exist_ok=True)
