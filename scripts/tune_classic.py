@@ -1,6 +1,6 @@
 """Tune the classic controllers of every env: the gains ``classic-tuned`` ships with.
 
-    python scripts/tune_classic.py [--only TEXT] [--episodes N] [--out DIR]
+    python scripts/tune_classic.py [--only TEXT] [--episodes N] [--out DIR] [--report-only]
 
 For each env of :data:`shipgym.envs.CURRENT_ENV_IDS` (or those whose id contains TEXT) this
 runs :func:`shipgym.benchmark.tuning.tune` (a grid over the classic structure's design
@@ -90,13 +90,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--episodes", type=int, default=TUNING_EPISODES, help="per candidate")
     p.add_argument("--out", default=str(TUNED_DIR), help="record folder (%(default)s)")
     p.add_argument("--no-report", action="store_true", help="skip docs/ and README")
+    p.add_argument(
+        "--report-only", action="store_true", help="only redraw docs/ and README from the records"
+    )
     args = p.parse_args(argv)
     if args.episodes < 1:
         p.error(f"--episodes must be >= 1, got {args.episodes}")
     envs = [e for e in CURRENT_ENV_IDS if args.only is None or args.only in e]
     if not envs:
         p.error(f"no env id contains {args.only!r}; ids: {', '.join(CURRENT_ENV_IDS)}")
-    for env_id in envs:
+    for env_id in [] if args.report_only else envs:
         record = tune(env_id, episodes=args.episodes)
         print(
             f"{env_id}: {record['design']} return {record['score']:.1f} (design rule "
