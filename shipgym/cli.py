@@ -7,11 +7,12 @@ Subcommands::
                   [--plot OUT.png]
     shipgym envs
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
-    shipgym evaluate --env ID [--controller classic|ppo|sac|zero] [--episodes N] [--seed S]
+    shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N] [--seed S]
                      [--agents DIR] [--json OUT] [--plot DIR]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
-                      [--env ID]... [--controller NAME]... [--condition C]... [--no-throughput]
+                      [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]
+                      [--no-throughput]
     shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
@@ -711,6 +712,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
         conditions=args.condition or CONDITIONS,
         agents_dir=args.agents,
         progress=progress,
+        jobs=args.jobs,
         **kwargs,
     )
     print(result.table())
@@ -815,6 +817,13 @@ def _build_benchmark(sub: Any) -> None:
         default=16_384,
         metavar="N",
         help="timed PPO steps per env and run (%(default)s)",
+    )
+    p.add_argument(
+        "--jobs",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="evaluations at once, one process each (default: one per core)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=_run_benchmark)

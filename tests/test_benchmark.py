@@ -38,7 +38,9 @@ def _quiet(line: str) -> None:
 
 @pytest.fixture(scope="module")
 def bench():
-    return run_benchmark(episodes=3, envs=[ENV], conditions=CONDITIONS, progress=_quiet)
+    return run_benchmark(
+        episodes=3, envs=[ENV], conditions=CONDITIONS, progress=_quiet, jobs=1, keep_logs=None
+    )
 
 
 def test_every_controller_sees_the_same_scenarios(bench) -> None:
@@ -117,6 +119,25 @@ def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     zero_row = next(line for line in md.splitlines() if line.startswith("| zero | -"))
     assert zero_row.split("|")[2].strip().endswith("**worse**")  # zero's return, paired
     assert "95 % interval" in md and "robustness.png" in md
+
+
+def test_parallel_cells_give_the_same_results(bench) -> None:
+    """Cells in worker processes: the same evaluations, in the same order; only the first
+    episode's log comes back."""
+    kw = {"episodes": 3, "envs": [ENV], "conditions": ("nominal", "noise"), "progress": _quiet}
+    par = run_benchmark(controllers=["classic-tuned", "ppo"], jobs=2, **kw)
+    assert [(r.controller, r.condition) for r in par.results] == [
+        ("classic-tuned", "nominal"), ("ppo", "nominal"), ("classic-tuned", "noise"),
+        ("ppo", "noise"),
+    ]  # fmt: skip
+    for r in par.results:
+        ref = bench.get(ENV, r.controller, r.condition)
+        assert r.returns == ref.returns and r.terminations == ref.terminations
+        for key in METRICS[ENV]:
+            np.testing.assert_array_equal(r.values(key), ref.values(key))
+        assert len(r.logs) == 1 and r.logs[0].seed == BENCHMARK_SEED
+    with pytest.raises(ValueError, match="jobs"):
+        run_benchmark(jobs=0, **kw)
 
 
 def test_seed_guard_refuses_training_seeds() -> None:

@@ -109,6 +109,8 @@ class EvaluationResult:
     logs: list[EpisodeLog] = field(repr=False)
     options: dict[str, Any] = field(default_factory=dict)
     condition: str = "nominal"
+    #: How each episode ended (``info["termination_reason"]`` of its last step).
+    terminations: list[str] = field(default_factory=list)
 
     def values(self, key: str) -> np.ndarray:
         """Per-episode values of a metric (NaN where undefined: never settled)."""
@@ -166,9 +168,7 @@ class EvaluationResult:
             "metrics_defined": self.metrics_defined,
             "returns": [float(r) for r in self.returns],
             "per_episode": {k: [float(x) for x in self.values(k)] for k in METRICS[self.env]},
-            "termination": [
-                log.info[-1].get("termination_reason") if log.info else None for log in self.logs
-            ],
+            "termination": list(self.terminations),
             "options": self.options,
         }
 
@@ -444,4 +444,5 @@ def evaluate(
         logs=logs,
         options=dict(reset_options or {}),
         condition=condition,
+        terminations=[str(log.info[-1]["termination_reason"]) for log in logs],
     )

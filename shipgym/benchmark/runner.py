@@ -30,9 +30,12 @@ from __future__ import annotations
 
 import csv
 import json
+import multiprocessing
+import os
 import sys
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -238,6 +241,46 @@ def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None
             )
 
 
+def _one_thread() -> None:
+    """Worker initializer: one torch thread per worker process (the workers share the cores)."""
+    try:
+        import torch
+    except ImportError:  # pragma: no cover - the rl extra is not installed
+        return
+    torch.set_num_threads(1)
+
+
+def _evaluate_cell(
+    env_id: str,
+    condition: str,
+    label: str,
+    stress: float,
+    name: str,
+    episodes: int,
+    seed: int,
+    agents_dir: str | Path | None,
+    keep_logs: int | None,
+) -> EvaluationResult:
+    """One benchmark cell: ``name`` on the ``label`` scenario of ``condition`` on ``env_id``
+    (the policy is made here, so that a worker process needs nothing but these arguments)."""
+    scenario = next(s for s in scenarios(env_id, condition, stress) if s.label == label)
+    result = evaluate(
+        env_id,
+        make_policy(name, env_id, agents_dir),
+        name,
+        episodes=episodes,
+        seed=seed,
+        env_kwargs=scenario.env_kwargs,
+        reset_options=scenario.reset_options,
+        progress=lambda line: None,
+        condition=label,
+        wrappers=scenario.wrappers,
+    )
+    if keep_logs is not None:
+        result.logs = result.logs[:keep_logs]
+    return result
+
+
 def run_benchmark(
     episodes: int = 100,
     seed: int = BENCHMARK_SEED,
@@ -246,6 +289,8 @@ def run_benchmark(
     conditions: Sequence[str] = CONDITIONS,
     agents_dir: str | Path | None = None,
     progress: Callable[[str], None] | None = None,
+    jobs: int | None = None,
+    keep_logs: int | None = 1,
 ) -> BenchmarkResult:
     """Evaluate ``controllers`` on ``envs`` under ``conditions`` on identical seeds.
 
@@ -261,6 +306,12 @@ def run_benchmark(
         Folder of the PPO/SAC agents (default: the shipped ones).
     progress : callable, optional
         Called with a line per finished evaluation (default: print to stderr).
+    jobs : int, optional
+        Evaluations run at once, each in its own process (default: one per core); 1 runs
+        them in this process. The results are the same either way.
+    keep_logs : int or None
+        Episode logs kept per evaluation (1: the first, for the trajectory figures; ``None``:
+        all). The metrics and per-episode values are kept for every episode regardless.
 
     Returns
     -------
@@ -276,13 +327,15 @@ def run_benchmark(
         bad = [g for g in given if g not in allowed]
         if bad or not given:
             raise ValueError(f"unknown {name}(s) {bad or given!r}; expected some of {allowed}")
+    jobs = (os.cpu_count() or 1) if jobs is None else jobs
+    if not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
     if progress is None:
 
         def progress(line: str) -> None:
             print(line, file=sys.stderr, flush=True)
 
     start = time.perf_counter()
-    policies: dict[tuple[str, str], Any] = {}
     agents: dict[str, dict[str, Any]] = {}
     for env_id in envs:  # load (and check) every policy before the first episode
         for name in controllers:
@@ -301,39 +354,39 @@ def run_benchmark(
                     seed,
                     episodes,
                 )
-            policies[env_id, name] = policy
     stress_current = {env_id: STRESS_FACTOR * training_max_current(env_id) for env_id in envs}
     cells = [
-        (env_id, scenario, name)
+        (env_id, condition, scenario.label, stress_current[env_id], name, episodes, seed,
+         agents_dir, keep_logs)
         for env_id in envs
         for condition in conditions
         for scenario in scenarios(env_id, condition, stress_current[env_id])
         for name in controllers
         if scenario.label == "nominal" or name not in NOMINAL_ONLY
-    ]
-    results = []
-    total = len(cells)
-    for env_id, scenario, name in cells:
-        t0 = time.perf_counter()
-        result = evaluate(
-            env_id,
-            policies[env_id, name],
-            name,
-            episodes=episodes,
-            seed=seed,
-            env_kwargs=scenario.env_kwargs,
-            reset_options=scenario.reset_options,
-            progress=lambda line: None,
-            condition=scenario.label,
-            wrappers=scenario.wrappers,
-        )
+    ]  # fmt: skip
+    results: list[EvaluationResult] = []
+
+    def report(result: EvaluationResult, seconds: float) -> None:
         results.append(result)
         d = result.to_dict()
         progress(
-            f"[{len(results)}/{total}] {env_id} {name} {scenario.label}: return "
-            f"{d['mean_return']:.1f} +- {d['std_return']:.1f} "
-            f"({time.perf_counter() - t0:.1f} s)"
+            f"[{len(results)}/{len(cells)}] {result.env} {result.controller} {result.condition}: "
+            f"return {d['mean_return']:.1f} +- {d['std_return']:.1f} ({seconds:.1f} s)"
         )
+
+    if jobs == 1:
+        for cell in cells:
+            t0 = time.perf_counter()
+            report(_evaluate_cell(*cell), time.perf_counter() - t0)
+    else:
+        context = multiprocessing.get_context("spawn")  # no fork of torch's or numba's threads
+        with ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread) as pool:
+            t0 = time.perf_counter()
+            futures = {pool.submit(_evaluate_cell, *cell): k for k, cell in enumerate(cells)}
+            for future in as_completed(futures):
+                report(future.result(), time.perf_counter() - t0)
+        order = {(c[0], c[2], c[4]): k for k, c in enumerate(cells)}  # env, label, controller
+        results.sort(key=lambda r: order[r.env, r.condition, r.controller])
     return BenchmarkResult(
         results=results,
         episodes=episodes,
