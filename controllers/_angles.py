@@ -82,7 +82,7 @@ def point(name: str, value: Any) -> np.ndarray:
         v = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         v = np.array([np.nan])
-    if v.shape != (2,) or not np.all(np.isfinite(v)):
+    if v.shape != (2,) or not (math.isfinite(v[0]) and math.isfinite(v[1])):
         raise ValueError(f"{name} must be 2 finite (north, east) values, got {value!r}")
     return v
 

@@ -123,15 +123,15 @@ class ConstantBearingGuidance:
         self, p: np.ndarray, pt: np.ndarray, vt: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         los = p - pt
-        rng = float(np.hypot(los[0], los[1]))
+        rng = math.hypot(los[0], los[1])
         if rng > 0:
             unit = los / rng
         else:
-            speed_t = float(np.hypot(vt[0], vt[1]))
+            speed_t = math.hypot(vt[0], vt[1])
             unit = -vt / speed_t if speed_t > 0 else np.array([-1.0, 0.0])
         aim = pt + self.distance * unit
         pe = p - aim
-        v_a = -self.max_approach_speed * pe / math.sqrt(float(pe @ pe) + self.delta**2)
+        v_a = -self.max_approach_speed * pe / math.sqrt(pe[0] ** 2 + pe[1] ** 2 + self.delta**2)
         return vt + v_a, v_a, aim, rng
 
     def update(
@@ -173,7 +173,7 @@ class ConstantBearingGuidance:
             vt = point("target_velocity", target_velocity)
         self._prev_target = pt
         v_d, v_a, aim, rng = self._velocity(p, pt, vt)
-        speed = float(np.hypot(v_d[0], v_d[1]))
+        speed = math.hypot(v_d[0], v_d[1])
         if speed > _MIN_COURSE_SPEED:
             self.chi_d = ssa(math.atan2(v_d[1], v_d[0]))
         self.U_d = min(max(speed, self.min_speed), self.max_speed)

@@ -7,8 +7,8 @@ Subcommands::
                   [--plot OUT.png]
     shipgym envs
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
-    shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N] [--seed S]
-                     [--agents DIR] [--json OUT] [--plot DIR]
+    shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N]
+                     [--seed S] [--agents DIR] [--json OUT] [--plot DIR]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
                       [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]

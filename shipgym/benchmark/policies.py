@@ -31,8 +31,7 @@ agents the same way. Its few design parameters (:attr:`DESIGN` of each class) co
   rad/s, 0.04 rad/s) so the heading loop stays inside the guidance loop, speed autopilot at
   the service speed.
 * RVGTargetTracking: constant-bearing guidance (seed 004 eq. 11) with an approach speed of 2
-  m/s and ``Delta`` 100 m, heading autopilot with the step reference, and a thrust floor of a
-  quarter of the service thrust (the pods steer with their thrust).
+  m/s and ``Delta`` 100 m, heading autopilot with the step reference, no thrust floor.
 
 ``classic-tuned``: the same structures with design parameters chosen by a grid search on the
 RL training seeds (:mod:`shipgym.benchmark.tuning`); the chosen values and the search's record
@@ -367,13 +366,13 @@ class RVGTargetClassic(ClassicPolicy):
     minus the measured crab angle, and the speed autopilot holds the speed over ground.
     Design parameters: ``approach_speed`` (``U_a,max`` [m/s]), ``delta`` (``Delta`` [m]),
     ``min_thrust`` (the least thrust the speed loop commands, a fraction of the service
-    thrust: azimuth pods steer with their thrust, so a ship slowing down to its target keeps
-    some to turn with) and the heading loop's ``omega_n``, ``reference_omega``,
-    ``max_turn_rate``.
+    thrust: azimuth pods steer with their thrust, so a floor keeps some to turn with while the
+    ship slows down, at the price of holding station behind a slow target) and the heading
+    loop's ``omega_n``, ``reference_omega``, ``max_turn_rate``.
     """
 
     DESIGN: ClassVar[dict[str, float | None]] = {
-        "approach_speed": 2.0, "delta": 100.0, "min_thrust": 0.25, "omega_n": None,
+        "approach_speed": 2.0, "delta": 100.0, "min_thrust": 0.0, "omega_n": None,
         "reference_omega": 0.1, "max_turn_rate": 0.03,
     }  # fmt: skip
 
@@ -400,16 +399,22 @@ class RVGTargetClassic(ClassicPolicy):
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
         psi = state[2]
-        rot = np.array([[math.cos(psi), -math.sin(psi)], [math.sin(psi), math.cos(psi)]])
-        target = state[:2] + rot @ obs[0:2]  # relative position, body -> NED
-        ship_velocity = rot @ state[[IU, IV]]
-        target_velocity = ship_velocity + rot @ obs[2:4]
+        c, s = math.cos(psi), math.sin(psi)
+
+        def to_ned(a: float, b: float) -> tuple[float, float]:  # body frame -> NED
+            return c * a - s * b, s * a + c * b
+
+        rel = to_ned(obs[0], obs[1])  # the target's relative position
+        ship_velocity = to_ned(state[IU], state[IV])
+        rel_velocity = to_ned(obs[2], obs[3])
+        target = (state[0] + rel[0], state[1] + rel[1])
+        target_velocity = (ship_velocity[0] + rel_velocity[0], ship_velocity[1] + rel_velocity[1])
         chi_d, u_d = self.guidance.update(self.t, state[:2], target, target_velocity)
         # the guidance asks for a course and speed over ground: steer the heading that gives
         # that course with the measured sideslip (current, drift), and hold the ground speed
         crab = math.atan2(ship_velocity[1], ship_velocity[0]) - psi
         azimuth = self.heading.update(self.t, psi, state[IR], chi_d - crab)
-        thrust = self.speed.update(self.t, float(np.hypot(*ship_velocity)), u_d)
+        thrust = self.speed.update(self.t, math.hypot(*ship_velocity), u_d)
         self.t += self.dt
         return PodCommand(azimuth, thrust).to_env_action("target", max_azimuth=self.max_azimuth)
 
