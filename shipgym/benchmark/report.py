@@ -117,7 +117,9 @@ def paired_metrics_tables(
 def robustness_table(entries: Sequence[dict[str, Any]]) -> list[str]:
     """Markdown lines: each controller's mean return per condition and its change from nominal
     (who degrades more under stress, on the wrong ship, with noisy sensors, with a delay)."""
-    conds = list(dict.fromkeys(e["condition"] for e in entries))
+    from shipgym.benchmark.runner import condition_order
+
+    conds = sorted(dict.fromkeys(e["condition"] for e in entries), key=condition_order)
     if len(conds) < 2 or "nominal" not in conds:
         return []
     by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}

@@ -72,6 +72,12 @@ MISMATCH_SHIPS: dict[str, dict[str, dict[str, Any]]] = {
 }
 
 
+def condition_order(label: str) -> int:
+    """Sort key of a scenario label (``"mismatch:bech"``): its condition's place in
+    :data:`CONDITIONS`."""
+    return CONDITIONS.index(label.split(":")[0])
+
+
 @dataclass(frozen=True)
 class Scenario:
     """One condition of one env as :func:`evaluate` runs it."""
@@ -128,8 +134,8 @@ class BenchmarkResult:
 
     @property
     def conditions(self) -> list[str]:
-        """The conditions evaluated, in order."""
-        return list(dict.fromkeys(r.condition for r in self.results))
+        """The conditions evaluated (scenario labels), in the order of :data:`CONDITIONS`."""
+        return sorted(dict.fromkeys(r.condition for r in self.results), key=condition_order)
 
     def get(self, env_id: str, controller: str, condition: str = "nominal") -> EvaluationResult:
         """The evaluation of one (env, controller, condition)."""
