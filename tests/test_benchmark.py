@@ -116,7 +116,8 @@ def test_outputs_json_csv_and_table(bench, tmp_path: Path) -> None:
     # classic-tuned for four controllers in nominal and three in the other three conditions
     assert md.count(f"| {name} |") == 4 + 4 + 3 * 3
     assert f"**{name}**: controller - `classic-tuned`" in md
-    zero_row = next(line for line in md.splitlines() if line.startswith("| zero | -"))
+    paired = md.split("controller - `classic-tuned`")[1]
+    zero_row = next(line for line in paired.splitlines() if line.startswith("| zero | -"))
     assert zero_row.split("|")[2].strip().endswith("**worse**")  # zero's return, paired
     assert "95 % interval" in md and "robustness.png" in md
 
