@@ -46,6 +46,6 @@ def test_paired_table_names_a_winner_only_outside_zero() -> None:
         {**base, "controller": "ppo", "returns": [1.0, 11.0, 21.0, 31.5]},
         {**base, "controller": "sac", "returns": [5.0, 5.0, 25.0, 25.0]},
     ]
-    lines = "\n".join(paired_table(entries))
+    lines = "\n".join(paired_table(entries, reference="classic"))
     assert "| RVGHeading-v0 | nominal | ppo | +1.12 |" in lines and "better" in lines
     assert "| RVGHeading-v0 | nominal | sac |" in lines and "no difference" in lines
