@@ -978,3 +978,28 @@ def test_rvg_envs_take_the_parameter_set(env_id: str) -> None:
     vec.close()
     with pytest.raises(ValueError, match="sea_trials"):
         gym.make(env_id, params="real")
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_vector_env_refuses_calls_out_of_order_as_the_single_env_does(env_id: str) -> None:
+    """Step or render before the first reset: Gymnasium's ``ResetNeeded``, as the single env
+    raises; any call after ``close``: ``ClosedEnvironmentError``; the state is untouched."""
+    single = gym.make(env_id, render_mode="rgb_array")
+    vec = gym.make_vec(
+        env_id, num_envs=2, vectorization_mode="vector_entry_point", render_mode="rgb_array"
+    )
+    actions = np.zeros((2, *single.action_space.shape), np.float32)
+    for call in (lambda e: e.step(actions[0]), lambda e: e.render()):
+        with pytest.raises(gym.error.ResetNeeded, match="before calling"):
+            call(single)
+    for call in (lambda e: e.step(actions), lambda e: e.render()):
+        with pytest.raises(gym.error.ResetNeeded, match=r"before calling env\.reset\(\)"):
+            call(vec)
+    vec.reset(seed=0)
+    vec.step(actions)
+    state = vec.task.x.copy()
+    vec.close()
+    for call in (lambda e: e.step(actions), lambda e: e.reset(seed=1)):
+        with pytest.raises(gym.error.ClosedEnvironmentError, match="closed"):
+            call(vec)
+    assert np.array_equal(vec.task.x, state)

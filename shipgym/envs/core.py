@@ -210,10 +210,22 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._rngs = [seeding.np_random(None)[0] for _ in range(self.num_envs)]
         self._prev_done = np.zeros(self.num_envs, dtype=np.bool_)
         self._single: ShipEnv | None = None
+        self._needs_reset = True
+
+    def _check_open(self, call: str, needs_reset: bool = True) -> None:
+        """The errors of the single env (Gymnasium's order enforcing) for a call before the
+        first ``reset``, and a clear one for a call after ``close``."""
+        if self.closed:
+            raise gym.error.ClosedEnvironmentError(
+                f"Cannot call env.{call}() on a closed vector env; make a new one"
+            )
+        if needs_reset and self._needs_reset:
+            raise gym.error.ResetNeeded(f"Cannot call env.{call}() before calling env.reset()")
 
     def reset(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        self._check_open("reset", needs_reset=False)
         if seed is not None:
             seeds = (
                 list(seed)
@@ -225,11 +237,13 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
         self.task.reset_rows(range(self.num_envs), self._rngs, options)
         self._prev_done[:] = False
+        self._needs_reset = False
         return self.task.obs.astype(np.float32), {}
 
     def step(
         self, actions: Any
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        self._check_open("step")
         task = self.task
         task.a[:] = _checked_shape(actions, task.a.shape, task.act_dim)
         bad = task.step()
@@ -262,6 +276,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         """Top-down view of sub-env 0 (``rgb_array`` only)."""
         if self.render_mode is None:
             return None
+        self._check_open("render")
         if self._single is None:
             self._single = self.single_env_cls(render_mode="rgb_array")
             self._single.task = self.task  # share the arrays; draw row 0
