@@ -38,14 +38,42 @@ Handler = Callable[[argparse.Namespace], int]
 Builder = Callable[["argparse._SubParsersAction[argparse.ArgumentParser]"], None]
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {text!r}")
-    return value
+def _int_in(lo: int, hi: int) -> Callable[[str], int]:
+    """An argparse type: an integer in ``[lo, hi]`` (a bound on every count and seed, so that
+    no flag can ask for an unbounded allocation)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi:,}], got {text!r}")
+        return value
+
+    return parse
+
+
+def _float_in(lo: float, hi: float, unit: str) -> Callable[[str], float]:
+    """An argparse type: a finite number in ``[lo, hi]`` (``unit`` for the message)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise argparse.ArgumentTypeError(
+                f"must be a number in [{lo:g}, {hi:g}] {unit}, got {text!r}"
+            )
+        return value
+
+    return parse
+
+
+#: Largest seed (numpy's and Gymnasium's seeds are 32-bit here) and episode count of a run.
+MAX_SEED = 2**32 - 1
+MAX_EPISODES = 1_000_000
 
 
 # ------------------------------------------------------------------------------------------
@@ -128,28 +156,28 @@ def _build_bench(sub: Any) -> None:
     )
     p.add_argument(
         "--steps",
-        type=_positive_int,
+        type=_int_in(1, 10**8),
         default=DEFAULT_STEPS,
         metavar="N",
         help="timed single-env steps per repeat (default: %(default)s)",
     )
     p.add_argument(
         "--num-envs",
-        type=_positive_int,
+        type=_int_in(1, 10**6),
         default=DEFAULT_NUM_ENVS,
         metavar="N",
         help="vector env batch size (default: %(default)s)",
     )
     p.add_argument(
         "--repeats",
-        type=_positive_int,
+        type=_int_in(1, 1000),
         default=DEFAULT_REPEATS,
         metavar="N",
         help="timed repeats per measurement, best one counts (default: %(default)s)",
     )
     p.add_argument(
         "--vec-steps",
-        type=_positive_int,
+        type=_int_in(1, 10**8),
         default=None,
         metavar="N",
         help="timed vector steps per repeat (default: max(5, steps // 200))",
@@ -478,7 +506,7 @@ def _build_simulate(sub: Any) -> None:
     )
     p.add_argument(
         "--reversals",
-        type=_positive_int,
+        type=_int_in(1, 100),
         default=None,
         metavar="N",
         help="zigzag: number of rudder reversals (default 4)",
@@ -490,7 +518,11 @@ def _build_simulate(sub: Any) -> None:
         help="spiral: direct (Dieudonne), reverse (Bech) or both (default)",
     )
     p.add_argument(
-        "--dt", type=_finite_float, default=None, metavar="S", help="integration step [s]"
+        "--dt",
+        type=_float_in(1e-3, 60.0, "s"),
+        default=None,
+        metavar="S",
+        help="integration step [s]",
     )
     p.add_argument("--json", default=None, metavar="OUT", help="write the results as JSON")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="write the standard figure")
@@ -559,8 +591,10 @@ def _build_evaluate(sub: Any) -> None:
     )
     p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
     p.add_argument("--controller", default="classic", choices=POLICIES, help="%(default)s")
-    p.add_argument("--episodes", type=_positive_int, default=10, metavar="N")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="first seed (%(default)s)")
+    p.add_argument("--episodes", type=_int_in(1, MAX_EPISODES), default=10, metavar="N")
+    p.add_argument(
+        "--seed", type=_int_in(0, MAX_SEED), default=0, metavar="S", help="first seed (%(default)s)"
+    )
     p.add_argument(
         "--agents",
         default=None,
@@ -569,7 +603,7 @@ def _build_evaluate(sub: Any) -> None:
     )
     p.add_argument(
         "--max-current-speed",
-        type=_finite_float,
+        type=_float_in(0.0, 5.0, "m/s"),
         default=None,
         metavar="M_S",
         help="upper end of the drawn current speed [m/s] (default: the env's)",
@@ -636,14 +670,14 @@ def _build_train(sub: Any) -> None:
     p.add_argument("--algo", required=True, choices=ALGOS, help="algorithm")
     p.add_argument(
         "--timesteps",
-        type=_positive_int,
+        type=_int_in(1, 10**9),
         default=None,
         metavar="N",
         help="environment steps (default: the shipped agent's budget)",
     )
     p.add_argument(
         "--seed",
-        type=_nonnegative_int,
+        type=_int_in(0, MAX_SEED),
         default=0,
         metavar="S",
         help="seed of the networks; training sub-env i gets S + i (%(default)s)",
@@ -651,21 +685,21 @@ def _build_train(sub: Any) -> None:
     p.add_argument("--out", default="shipgym-agents", metavar="DIR", help="%(default)s")
     p.add_argument(
         "--num-envs",
-        type=_positive_int,
+        type=_int_in(1, 65536),
         default=None,
         metavar="N",
         help="training sub-envs (default: 16 for PPO, 8 for SAC)",
     )
     p.add_argument(
         "--eval-freq",
-        type=_positive_int,
+        type=_int_in(1, 10**9),
         default=None,
         metavar="N",
         help="env steps between evaluations (default: 1/20 of the budget; PPO: at least a rollout)",
     )
     p.add_argument(
         "--eval-episodes",
-        type=_positive_int,
+        type=_int_in(1, 10**4),
         default=16,
         metavar="N",
         help="validation episodes per evaluation (%(default)s)",
@@ -764,14 +798,14 @@ def _build_benchmark(sub: Any) -> None:
     )
     p.add_argument(
         "--episodes",
-        type=_positive_int,
+        type=_int_in(1, MAX_EPISODES),
         default=100,
         metavar="N",
         help="episodes per env, controller and condition (%(default)s)",
     )
     p.add_argument(
         "--seed",
-        type=_nonnegative_int,
+        type=_int_in(0, MAX_SEED),
         default=BENCHMARK_SEED,
         metavar="S",
         help="first seed (%(default)s)",
@@ -813,14 +847,14 @@ def _build_benchmark(sub: Any) -> None:
     )
     p.add_argument(
         "--throughput-steps",
-        type=_positive_int,
+        type=_int_in(1, 10**8),
         default=16_384,
         metavar="N",
         help="timed PPO steps per env and run (%(default)s)",
     )
     p.add_argument(
         "--jobs",
-        type=_positive_int,
+        type=_int_in(1, 1024),
         default=None,
         metavar="N",
         help="evaluations at once, one process each (default: one per core)",
@@ -866,20 +900,10 @@ def _window(text: str) -> float | str | None:
         value = float(text)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value > 0):
+    if not (math.isfinite(value) and 1.0 <= value <= 1e6):
         raise argparse.ArgumentTypeError(
-            f"must be a positive number of seconds, 'auto' or 'none', got {text!r}"
+            f"must be a number of seconds in [1, 1e6], 'auto' or 'none', got {text!r}"
         )
-    return value
-
-
-def _nonnegative_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}")
     return value
 
 
@@ -1281,7 +1305,7 @@ def _build_identify(sub: Any) -> None:
     )
     p.add_argument(
         "--max-effects",
-        type=_nonnegative_int,
+        type=_int_in(0, 10),
         default=3,
         metavar="N",
         help="largest number of effects to add (default: %(default)s)",

@@ -83,6 +83,19 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
         (["bench", "--steps", "0"], "'0'"),
         (["bench", "--num-envs", "many"], "'many'"),
         (["frobnicate"], "'frobnicate'"),
+        # every numeric flag is bounded before the run: no traceback, no huge allocation
+        (["evaluate", "--env", "shipgym/RVGHeading-v1", "--seed", "-1"], "'-1'"),
+        (["evaluate", "--env", "shipgym/RVGHeading-v1", "--episodes", "1e20"], "'1e20'"),
+        (["evaluate", "--env", "shipgym/RVGHeading-v1", "--episodes", "100000000000"], "[1, "),
+        (["evaluate", "--env", "shipgym/RVGHeading-v1", "--max-current-speed", "1e308"], "m/s"),
+        (["simulate", "zigzag", "--dt", "1e-9"], "'1e-9'"),
+        (["simulate", "zigzag", "--reversals", "1000000"], "'1000000'"),
+        (["identify", "x.csv", "--window", "1e-9"], "'1e-9'"),
+        (["identify", "x.csv", "--max-effects", "99"], "'99'"),
+        (["train", "--env", "shipgym/RVGSpeed-v1", "--algo", "ppo", "--timesteps", "1e12"], "1e12"),
+        (["benchmark", "--episodes", "2000000"], "'2000000'"),
+        (["benchmark", "--seed", "99999999999"], "'99999999999'"),
+        (["bench", "--num-envs", "1000000000"], "'1000000000'"),
     ],
 )
 def test_bad_arguments_exit_2_with_a_message(argv: list[str], bad: str, capsys) -> None:
