@@ -134,7 +134,7 @@ def _bad_cases(records: dict[str, Path], tmp: Path) -> dict[str, tuple[list[str]
         "missing file": ([str(tmp / "nope.csv")], ["nope.csv", "does not exist"]),
         "unknown model": ([rec, "--model", "foo"], ["--model", "'foo'", "nomoto1"]),
         "unknown format": ([rec, "--format", "foo"], ["--format", "'foo'", "canonical"]),
-        "negative window": ([rec, "--window", "-3"], ["--window", "'-3'", "positive"]),
+        "negative window": ([rec, "--window", "-3"], ["--window", "'-3'", "[1, 1e6]"]),
         "holdout too large": ([rec, "--holdout", "0.95"], ["holdout", "0.95", "[0.1, 0.6]"]),
         "wrong format": ([rec, "--format", "sspa"], ["sspa", "header"]),
         "undetectable": ([str(unknown)], ["cannot detect the format", "--format"]),
