@@ -76,7 +76,7 @@ def rvg_heading_nomoto(
     acceleration per radian of azimuth, so ``K / T < 0`` (positive azimuth turns to port).
     """
     ship = make_model("rvg3dof", params=params)
-    thrust = _rvg_thrust(ship.params, speed)
+    thrust = ship.params.straight_thrust(speed)
     x0 = np.zeros(ship.nx)
     x0[IU], x0[IT1], x0[IT2] = speed, thrust, thrust
     A, _ = ship.linearize(x0, [thrust, thrust, 0.0, 0.0])
@@ -87,11 +87,6 @@ def rvg_heading_nomoto(
     T = -1.0 / lam
     yaw_accel_per_azimuth = A[IR, IA1] + A[IR, IA2]
     return float(yaw_accel_per_azimuth * T), T
-
-
-def _rvg_thrust(p: RVGParams, u: float) -> float:
-    """Per-pod thrust [N] that holds straight running at ``u`` in calm water."""
-    return p.straight_resistance(u) / (2.0 * (1.0 - p.thrust_deduction))
 
 
 def nomoto_heading_autopilot(
@@ -169,7 +164,7 @@ def _rvg_speed_autopilot(
         dt,
         omega_n=omega_n,
         zeta=zeta,
-        feedforward=lambda u: _rvg_thrust(p, u),
+        feedforward=p.straight_thrust,
         min_command=min_thrust * p.service_thrust,
         max_command=p.max_thrust,
     )

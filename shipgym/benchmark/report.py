@@ -68,10 +68,10 @@ def metrics_tables(entries: Sequence[dict[str, Any]], condition: str = "nominal"
 
 
 def _paired_cell(a: Sequence[float], b: Sequence[float], higher_is_better: bool) -> str:
-    both = np.isfinite(np.asarray(a, dtype=float)) & np.isfinite(np.asarray(b, dtype=float))
-    if both.sum() < 2:
+    # paired_difference pairs the episodes where both are defined; it needs two of them
+    if np.isfinite(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)).sum() < 2:
         return "—"
-    mean, lo, hi = paired_difference(np.asarray(a)[both], np.asarray(b)[both])
+    mean, lo, hi = paired_difference(a, b)
     word = verdict(lo, hi, higher_is_better)
     mark = {"better": " **better**", "worse": " **worse**"}.get(word, "")
     return f"{mean:+.3g} [{lo:+.3g}, {hi:+.3g}]{mark}"

@@ -232,7 +232,7 @@ def _beyond_edge(
         nxt = max(value * grid[0] / grid[1], bounds[0])
     else:
         return None
-    return None if math.isclose(nxt, value) or nxt == value else nxt
+    return None if math.isclose(nxt, value) else nxt
 
 
 def _fmt(value: float | None) -> str:

@@ -332,8 +332,12 @@ class RVGParams:
             name="sea_trials",
             **{k: val for k, val in v.items() if not k.endswith("_linear_damping")},
         )
-        thrust = fitted.straight_resistance(SERVICE_SPEED) / (2.0 * (1.0 - fitted.thrust_deduction))
-        return replace(fitted, service_thrust=thrust)
+        return replace(fitted, service_thrust=fitted.straight_thrust(SERVICE_SPEED))
+
+    def straight_thrust(self, u: float) -> float:
+        """Thrust [N] of each pod that holds straight running at ``u`` [m/s] in calm water:
+        half the :meth:`straight_resistance`, raised by the thrust deduction."""
+        return self.straight_resistance(u) / (2.0 * (1.0 - self.thrust_deduction))
 
     def straight_resistance(self, u: float) -> float:
         """Surge resistance [N] of straight running at ``u`` [m/s] in calm water: the linear,
