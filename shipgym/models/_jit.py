@@ -10,18 +10,27 @@ Numba alone only invalidates a cached function when its own file changes, and a 
 inlines a changed kernel from another file would otherwise load stale machine code. The
 directory is ``$SHIPGYM_CACHE_DIR`` or ``~/.cache/shipgym/numba-<hash>``; set
 ``SHIPGYM_NO_CACHE=1`` to compile without any cache.
+
+A cache entry that cannot be read (an empty file left by a full disk or a killed process, a
+garbled or foreign file) repairs itself: the function's index and data files are removed with a
+``RuntimeWarning`` naming them, the kernel is recompiled and the fresh entry replaces them.
+Numba alone would raise ``EOFError``/``UnpicklingError`` on every later run until the folder is
+deleted by hand.
 """
 
 from __future__ import annotations
 
+import glob
 import hashlib
 import os
 import types
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numba
+from numba.core.caching import FunctionCache
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -43,13 +52,61 @@ def _cache_dir() -> str:
 _CACHE_DIR = _cache_dir() if _CACHE else ""
 
 
+class _SelfRepairingCache(FunctionCache):
+    """Numba's on-disk function cache, which replaces an entry it cannot read.
+
+    Any error while reading the index or a data file (``EOFError`` for an empty file,
+    ``UnpicklingError`` or another unpickling error for a garbled one) removes this function's
+    cache files with a warning and reports a miss, so Numba compiles the kernel and saves a
+    fresh entry in their place.
+    """
+
+    def _repair(self, exc: BaseException) -> None:
+        cache_file = self._cache_file
+        index = cache_file._index_path
+        stem = os.path.join(cache_file._cache_path, os.path.basename(index)[: -len(".nbi")])
+        files = [index, *glob.glob(glob.escape(stem) + ".*.nbc")]
+        removed = []
+        for path in files:
+            try:
+                os.remove(path)
+                removed.append(os.path.basename(path))
+            except OSError:  # already gone, or not ours to remove: Numba overwrites it
+                pass
+        warnings.warn(
+            f"shipgym: unreadable compiled-kernel cache for {self._py_func.__qualname__} in "
+            f"{cache_file._cache_path} ({type(exc).__name__}: {exc}); removed "
+            f"{', '.join(removed) or 'nothing'} and recompiling",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        try:
+            return super().load_overload(sig, target_context)
+        except Exception as exc:  # any unreadable entry: a miss, repaired below
+            self._repair(exc)
+            return None
+
+    def save_overload(self, sig: Any, data: Any) -> None:
+        try:
+            super().save_overload(sig, data)
+        except OSError:
+            raise
+        except Exception as exc:  # the index was unreadable: start it afresh
+            self._repair(exc)
+            super().save_overload(sig, data)
+
+
 def _compile(func: F, **options: Any) -> F:
     if not _CACHE:
         return numba.njit(**options)(func)  # type: ignore[return-value]
     previous = numba.config.CACHE_DIR
     numba.config.CACHE_DIR = _CACHE_DIR  # read once, when the dispatcher sets up its cache
     try:
-        return numba.njit(cache=True, **options)(func)  # type: ignore[return-value]
+        dispatcher = numba.njit(cache=True, **options)(func)
+        dispatcher._cache = _SelfRepairingCache(dispatcher.py_func)
+        return dispatcher  # type: ignore[return-value]
     finally:
         numba.config.CACHE_DIR = previous
 

@@ -1,0 +1,49 @@
+"""The on-disk cache of compiled kernels repairs an entry it cannot read."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+# compiles one small kernel from the cache folder given in the environment
+_RUN = (
+    "import warnings, numpy as np\n"
+    "warnings.simplefilter('always')\n"
+    "from shipgym.models.angles import ssa_scalar\n"
+    "assert abs(ssa_scalar(4.0) - (4.0 - 2 * np.pi)) < 1e-12\n"
+    "print('ok')\n"
+)
+
+
+def _run(cache: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "SHIPGYM_CACHE_DIR": str(cache)}
+    env.pop("SHIPGYM_NO_CACHE", None)
+    return subprocess.run(
+        [sys.executable, "-c", _RUN], env=env, capture_output=True, text=True, timeout=300
+    )
+
+
+@pytest.mark.parametrize("damage", ["empty", "garbled"])
+def test_unreadable_cache_entry_is_recompiled_and_replaced(tmp_path: Path, damage: str) -> None:
+    cache = tmp_path / "cache"
+    first = _run(cache)
+    assert first.returncode == 0, first.stderr
+    entries = sorted(cache.rglob("*ssa*.nb[ic]"))
+    assert entries, f"no cache entry written in {cache}"
+    for path in entries:
+        path.write_bytes(b"" if damage == "empty" else b"\x80\x04not a pickle\xff" * 7)
+
+    repaired = _run(cache)
+    assert repaired.returncode == 0, repaired.stderr
+    assert repaired.stdout.strip() == "ok"
+    assert "unreadable compiled-kernel cache" in repaired.stderr
+    assert "recompiling" in repaired.stderr
+    assert all(p.stat().st_size > 0 for p in cache.rglob("*ssa*.nb[ic]"))
+
+    clean = _run(cache)
+    assert clean.returncode == 0, clean.stderr
+    assert "unreadable" not in clean.stderr
