@@ -82,10 +82,11 @@ MAX_EPISODES = 1_000_000
 def _run_demo(args: argparse.Namespace) -> int:
     from shipgym.demo import format_summary, run_demo
 
+    out = _output_dir(args.out, "--out")
     print(
         f"running the shipgym demo (zigzag 20/20 with {args.model}, path following) ...", flush=True
     )
-    summary = run_demo(args.out, model=args.model)
+    summary = run_demo(out, model=args.model)
     print(format_summary(summary))
     return 0
 
@@ -124,6 +125,8 @@ def _build_demo(sub: Any) -> None:
 def _run_bench(args: argparse.Namespace) -> int:
     from shipgym.bench import format_table, plot_ratios, run_bench, write_json
 
+    json_path = _output_path(args.json, "--json", ".json")
+    plot_path = _output_path(args.plot, "--plot", ".png")
     print(
         f"shipgym bench: single env {args.steps} steps x {args.repeats} repeats, vector "
         f"{args.num_envs} envs; one line per measurement as it completes",
@@ -134,10 +137,14 @@ def _run_bench(args: argparse.Namespace) -> int:
         steps=args.steps, num_envs=args.num_envs, repeats=args.repeats, vec_steps=args.vec_steps
     )
     print(format_table(report))
-    if args.json:
-        print(f"wrote {write_json(report, args.json)}")
-    if args.plot:
-        print(f"wrote {plot_ratios(report, args.plot)}")
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = []
+    if json_path is not None:
+        outputs.append((json_path, lambda p: write_json(report, p)))
+    if plot_path is not None:
+        outputs.append((plot_path, lambda p: plot_ratios(report, p)))
+    _write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}")
     return 0
 
 
@@ -397,7 +404,6 @@ _SIMULATE: dict[str, Callable[[argparse.Namespace], _Trial]] = {
 
 def _run_simulate(args: argparse.Namespace) -> int:
     import json
-    from pathlib import Path
 
     from shipgym.maneuvers import PARTICULARS, format_imo_table
 
@@ -409,8 +415,8 @@ def _run_simulate(args: argparse.Namespace) -> int:
     ):
         if value is not None and kind != only:
             raise ValueError(f"{flag} applies to the {only} only, not to {kind!r}")
-    if args.plot and Path(args.plot).suffix.lower() != ".png":
-        raise ValueError(f"--plot must name a .png file, got {args.plot!r}")
+    json_path = _output_path(args.json, "--json", ".json")
+    plot_path = _output_path(args.plot, "--plot", ".png")
     from shipgym.models import make_model
     from shipgym.models.rvg import RVG_PARAMETER_SETS
 
@@ -446,12 +452,15 @@ def _run_simulate(args: argparse.Namespace) -> int:
         title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
         print(format_imo_table(rows, title=title))
         payload["imo"] = [row.to_dict() for row in rows]
-    if args.json:
-        out = Path(args.json)
-        out.write_text(json.dumps(payload, indent=1, allow_nan=False) + "\n")
-        print(f"wrote {out}")
-    if args.plot:
-        print(f"wrote {draw(args.plot)}")
+    text = json.dumps(payload, indent=1, allow_nan=False) + "\n"
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = []
+    if json_path is not None:
+        outputs.append((json_path, lambda p: p.write_text(text)))
+    if plot_path is not None:
+        outputs.append((plot_path, draw))
+    _write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}")
     return 0
 
 
@@ -536,9 +545,10 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     import json
 
     from shipgym.benchmark import evaluate, make_policy
-    from shipgym.benchmark.plots import plot_result
+    from shipgym.benchmark.plots import episode_figures
 
     json_path = _output_path(args.json, "--json", ".json")
+    plot_dir = None if args.plot is None else _output_dir(args.plot, "--plot")
     policy = make_policy(args.controller, args.env, args.agents)
     if hasattr(policy, "meta"):
         from shipgym.benchmark.runner import check_seeds_disjoint
@@ -564,14 +574,14 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     print(f"  return {summary['mean_return']:.2f} +- {summary['std_return']:.2f}")
     for key, value in summary["metrics"].items():
         print(f"  {key:22s} {value:10.3f} +- {summary['metrics_std'][key]:.3f}")
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = []
     if json_path is not None:
-        _write_atomically(
-            [(json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n"))]
-        )
-        print(f"wrote {json_path}")
-    if args.plot:
-        for path in plot_result(result, args.plot, max_episodes=args.episodes):
-            print(f"wrote {path}")
+        outputs.append((json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n")))
+    if plot_dir is not None:
+        outputs += episode_figures(result, plot_dir, max_episodes=args.episodes)
+    _write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}")
     return 0
 
 
@@ -622,6 +632,7 @@ def _run_train(args: argparse.Namespace) -> int:
     from shipgym.rl.train import config, train
 
     cfg = config(args.env, args.algo)
+    out = _output_dir(args.out, "--out")
     timesteps = args.timesteps or cfg["timesteps"]
     bar = not args.quiet and sys.stderr.isatty()
     print(
@@ -634,7 +645,7 @@ def _run_train(args: argparse.Namespace) -> int:
         args.algo,
         timesteps=timesteps,
         seed=args.seed,
-        out_dir=args.out,
+        out_dir=out,
         num_envs=args.num_envs,
         eval_freq=args.eval_freq,
         eval_episodes=args.eval_episodes,
@@ -723,15 +734,10 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     from shipgym.benchmark.runner import CONDITIONS, run_benchmark
     from shipgym.benchmark.throughput import ppo_throughput, throughput_table
 
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out names a file, expected a directory: {args.out!r}")
-    out.mkdir(parents=True, exist_ok=True)
-    json_path = _output_path(args.json or str(out / "benchmark.json"), "--json", ".json")
-    csv_path = _output_path(args.csv or str(out / "benchmark.csv"), "--csv", ".csv")
-    plots = Path(args.plots) if args.plots else out
-    if plots.exists() and not plots.is_dir():
-        raise ValueError(f"--plots names a file, expected a directory: {args.plots!r}")
+    out = _output_dir(args.out, "--out")
+    json_path = _output_path(args.json, "--json", ".json") or out / "benchmark.json"
+    csv_path = _output_path(args.csv, "--csv", ".csv") or out / "benchmark.csv"
+    plots = _output_dir(args.plots, "--plots") if args.plots else out
     envs = args.env or None
     controllers = args.controller or None
     progress = (lambda line: None) if args.quiet else _progress
@@ -751,28 +757,33 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     )
     print(result.table())
     print(f"({result.runtime_s:.0f} s)")
-    assert json_path is not None and csv_path is not None
-    _write_atomically(
-        [
-            (json_path, lambda p: result.write_json(p)),
-            (csv_path, lambda p: result.write_csv(p)),
-        ]
-    )
-    print(f"wrote {json_path} and {csv_path}")
-    plots.mkdir(parents=True, exist_ok=True)
-    print(f"wrote {plot_benchmark_metrics(result, plots / 'metrics.png')}")
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = [
+        (json_path, result.write_json),
+        (csv_path, result.write_csv),
+        (plots / "metrics.png", lambda p: plot_benchmark_metrics(result, p)),
+    ]
     if len(result.conditions) > 1:
-        print(f"wrote {plot_benchmark_robustness(result, plots / 'robustness.png')}")
+        outputs.append((plots / "robustness.png", lambda p: plot_benchmark_robustness(result, p)))
     for env_id in result.envs:
-        name = env_id.split("/")[-1]
-        print(f"wrote {plot_benchmark_trajectories(result, env_id, plots / f'{name}.png')}")
+        outputs.append(
+            (
+                plots / f"{env_id.split('/')[-1]}.png",
+                lambda p, env_id=env_id: plot_benchmark_trajectories(result, env_id, p),
+            )
+        )
+    _write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}")
     if not args.no_throughput:
         rows = ppo_throughput(result.envs, timesteps=args.throughput_steps, progress=progress)
         print(throughput_table(rows))
-        path = out / "throughput.json"
-        _write_atomically([(path, lambda p: p.write_text(json.dumps(rows, indent=2) + "\n"))])
-        print(f"wrote {path}")
-        print(f"wrote {plot_throughput(rows, plots / 'throughput.png')}")
+        outputs = [
+            (out / "throughput.json", lambda p: p.write_text(json.dumps(rows, indent=2) + "\n")),
+            (plots / "throughput.png", lambda p: plot_throughput(rows, p)),
+        ]
+        _write_atomically(outputs)
+        for target, _ in outputs:
+            print(f"wrote {target}")
     return 0
 
 
@@ -907,8 +918,25 @@ def _window(text: str) -> float | str | None:
     return value
 
 
+def _probe_directory(directory: Path, flag: str, target: str) -> None:
+    """Create and remove a temporary file in ``directory``: can ``target`` be written there?"""
+    import os
+    import tempfile
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".shipgym-probe-", dir=directory)
+    except OSError as exc:
+        raise ValueError(f"{flag}: cannot write {target!r}: {exc.strerror or exc}") from None
+    os.close(fd)
+    os.unlink(probe)
+
+
 def _output_path(text: str | None, flag: str, suffix: str | None = None) -> Path | None:
-    """Check an output file name before the (possibly long) run; ``-`` and None pass."""
+    """Check an output file before the (possibly long) run; ``-`` and None pass.
+
+    The file's directory must exist and take a new file (tried with a temporary file); an
+    existing output must be a regular file, which is replaced.
+    """
     if text is None or text == "-":
         return None
     path = Path(text)
@@ -916,15 +944,32 @@ def _output_path(text: str | None, flag: str, suffix: str | None = None) -> Path
         raise ValueError(f"{flag} must name a {suffix} file, got {text!r}")
     if path.is_dir():
         raise ValueError(f"{flag} names a directory, expected a file: {text!r}")
+    if path.exists() and not path.is_file():
+        raise ValueError(f"{flag}: {text!r} exists and is not a regular file")
     if not path.parent.is_dir():
         raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
+    _probe_directory(path.parent, flag, text)
+    return path
+
+
+def _output_dir(text: str, flag: str) -> Path:
+    """Check an output directory before the run: an existing one that takes files, or a new
+    one in an existing directory (created when the outputs are written, never its parents)."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{flag} names a file, expected a directory: {text!r}")
+    if not path.exists() and not path.parent.is_dir():
+        raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
+    _probe_directory(path if path.exists() else path.parent, flag, text)
     return path
 
 
 def _write_atomically(outputs: Sequence[tuple[Path, Callable[[Path], Any]]]) -> None:
     """Write every ``(target, writer)`` to a temporary file next to it, then rename them all.
 
-    A failure in any writer leaves no output (and no temporary file) behind.
+    A failure in any writer leaves no output (and no temporary file) behind, and its message
+    names the target. A target's own directory is created (never its parents: the output
+    checks above have seen that they exist).
     """
     import os
     import uuid
@@ -932,9 +977,13 @@ def _write_atomically(outputs: Sequence[tuple[Path, Callable[[Path], Any]]]) -> 
     temps: list[tuple[Path, Path]] = []
     try:
         for target, write in outputs:
+            target.parent.mkdir(exist_ok=True)
             tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:8]}.tmp{target.suffix}")
             temps.append((tmp, target))
-            write(tmp)
+            try:
+                write(tmp)
+            except OSError as exc:
+                raise OSError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from exc
         for tmp, target in temps:
             os.replace(tmp, target)
     finally:

@@ -159,3 +159,87 @@ def test_simulate_takes_the_rvg_parameter_set(tmp_path: Path) -> None:
         diam[name] = doc["tactical_diameter_m"]
     assert diam["sea_trials"] != pytest.approx(diam["seed001"], rel=0.05)
     assert main(["simulate", "turning", "--params", "sea_trials"]) == 2
+
+
+def _no_run(*args: object, **kwargs: object) -> None:
+    raise AssertionError("the run started before its outputs were checked")
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag", "named"),
+    [
+        (["bench", "--json", "/proc/x.json"], "--json", "/proc/x.json"),
+        (["bench", "--json", "{tmp}/nonexist/b.json"], "--json", "nonexist"),
+        (["bench", "--plot", "{tmp}"], "--plot", ".png"),
+        (
+            ["simulate", "zigzag", "--json", "{tmp}/ok.json", "--plot", "{tmp}/nonexist/x.png"],
+            "--plot",
+            "nonexist",
+        ),
+        (["simulate", "zigzag", "--json", "{tmp}/dir.json"], "--json", "dir.json"),
+        (
+            ["evaluate", "--env", "shipgym/RVGHeading-v1", "--plot", "{tmp}/file.txt"],
+            "--plot",
+            "file.txt",
+        ),
+        (
+            ["evaluate", "--env", "shipgym/RVGHeading-v1", "--json", "/proc/e.json"],
+            "--json",
+            "/proc/e.json",
+        ),
+        (["benchmark", "--out", "{tmp}/nonexist/deeper"], "--out", "nonexist"),
+        (["benchmark", "--plots", "/proc/figures"], "--plots", "/proc/figures"),
+        (["identify", "{tmp}/file.txt", "--json", "/proc/fit.json"], "--json", "/proc/fit.json"),
+        (
+            ["train", "--env", "shipgym/RVGSpeed-v1", "--algo", "ppo", "--out", "/proc/agents"],
+            "--out",
+            "/proc/agents",
+        ),
+        (["demo", "--out", "/proc/demo"], "--out", "/proc/demo"),
+    ],
+)
+def test_outputs_are_checked_before_the_run_and_nothing_is_created(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys, argv: list[str], flag: str, named: str
+) -> None:
+    import importlib
+
+    for module, name in [
+        ("shipgym.bench", "run_bench"),
+        ("shipgym.benchmark", "evaluate"),
+        ("shipgym.benchmark.runner", "run_benchmark"),
+        ("shipgym.demo", "run_demo"),
+        ("shipgym.maneuvers", "zigzag"),
+        ("shipgym.rl.train", "train"),
+    ]:
+        monkeypatch.setattr(importlib.import_module(module), name, _no_run)
+    (tmp_path / "dir.json").mkdir()
+    (tmp_path / "file.txt").write_text("x")
+    before = sorted(tmp_path.rglob("*"))
+    assert main([a.replace("{tmp}", str(tmp_path)) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("shipgym: error: ") and flag in err and named in err, err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert sorted(tmp_path.rglob("*")) == before
+
+
+def test_simulate_writes_both_outputs_and_no_temporary_file(tmp_path: Path, capsys) -> None:
+    json_path, png = tmp_path / "ok.json", tmp_path / "ok.png"
+    png.write_bytes(b"an older figure, replaced")
+    argv = ["simulate", "zigzag", "--json", str(json_path), "--plot", str(png)]
+    assert main(argv) == 0
+    assert json.loads(json_path.read_text())["overshoots_deg"]
+    assert _is_png(png)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.json", "ok.png"]
+
+
+def test_a_failed_write_leaves_no_output_and_names_the_target(tmp_path: Path) -> None:
+    from shipgym.cli import _write_atomically
+
+    def fail(path: Path) -> None:
+        path.write_text("half")
+        raise OSError(28, "No space left on device")
+
+    first, second = tmp_path / "a.json", tmp_path / "b.png"
+    with pytest.raises(OSError, match=r"cannot write '.*b\.png': No space left on device"):
+        _write_atomically([(first, lambda p: p.write_text("{}")), (second, fail)])
+    assert list(tmp_path.iterdir()) == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -87,11 +88,20 @@ def plot_episode(result: EvaluationResult, log: EpisodeLog, path: str | Path) ->
     return path
 
 
-def plot_result(result: EvaluationResult, out_dir: str | Path, max_episodes: int = 5) -> list[Path]:
-    """Write one PNG per episode (the first ``max_episodes``) into ``out_dir``."""
+def episode_figures(
+    result: EvaluationResult, out_dir: str | Path, max_episodes: int = 5
+) -> list[tuple[Path, Callable[[Path], Path]]]:
+    """One PNG per episode (the first ``max_episodes``) in ``out_dir``, not yet drawn.
+
+    Returns ``(path, write)`` pairs; ``write(file)`` draws that episode's figure into ``file``,
+    so a caller can write them all atomically (temporary files renamed at the end).
+    """
     name = result.env.split("/")[-1]
     return [
-        plot_episode(result, log, Path(out_dir) / f"{name}_{result.controller}_seed{log.seed}.png")
+        (
+            Path(out_dir) / f"{name}_{result.controller}_seed{log.seed}.png",
+            lambda file, log=log: plot_episode(result, log, file),
+        )
         for log in result.logs[:max_episodes]
     ]
 
