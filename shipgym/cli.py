@@ -545,6 +545,7 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     import json
 
     from shipgym.benchmark import evaluate, make_policy
+    from shipgym.benchmark.evaluate import BLOW_UP
     from shipgym.benchmark.plots import episode_figures
 
     json_path = _output_path(args.json, "--json", ".json")
@@ -571,9 +572,18 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     print(
         f"{args.env} controller {args.controller}: {args.episodes} episodes from seed {args.seed}"
     )
-    print(f"  return {summary['mean_return']:.2f} +- {summary['std_return']:.2f}")
-    for key, value in summary["metrics"].items():
-        print(f"  {key:22s} {value:10.3f} +- {summary['metrics_std'][key]:.3f}")
+    if result.blown_up:
+        ends = zip(result.lengths, result.terminations, strict=True)
+        steps = [n for n, reason in ends if reason == BLOW_UP]
+        print(
+            f"  BLEW UP: {result.blown_up} of {args.episodes} episodes ended in a numerical "
+            f"blow-up (at steps {', '.join(map(str, steps[:10]))}"
+            f"{', ...' if len(steps) > 10 else ''}); return and metrics undefined"
+        )
+    else:
+        print(f"  return {summary['mean_return']:.2f} +- {summary['std_return']:.2f}")
+        for key, value in summary["metrics"].items():
+            print(f"  {key:22s} {value:10.3f} +- {summary['metrics_std'][key]:.3f}")
     outputs: list[tuple[Path, Callable[[Path], Any]]] = []
     if json_path is not None:
         outputs.append((json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n")))

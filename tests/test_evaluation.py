@@ -231,3 +231,64 @@ def test_engineering_metrics_against_hand_computed_signals() -> None:
     minutes = angle.size / 60.0
     assert wear["rudder_travel_deg_min"] == pytest.approx(40.0 / minutes)
     assert wear["rudder_reversals_min"] == pytest.approx(2.0 / minutes)
+
+
+class _BlowUpOnOddSeeds:
+    """Wrapper factory: the ship's state turns non-finite before step 3 of odd-seeded episodes
+    (what a diverging integration leaves), so the env ends them as numerical blow-ups."""
+
+    def __call__(self, env):
+        import gymnasium as gym
+
+        class BlowUp(gym.Wrapper):
+            def reset(self, **kwargs):
+                self.blow, self.steps = kwargs.get("seed", 0) % 2 == 1, 0
+                return super().reset(**kwargs)
+
+            def step(self, action):
+                self.steps += 1
+                if self.blow and self.steps == 3:
+                    self.env.unwrapped.task.x[0, :] = np.nan
+                return super().step(action)
+
+        return BlowUp(env)
+
+
+def test_blown_up_episodes_are_counted_flagged_and_never_look_good(tmp_path: Path) -> None:
+    from shipgym.benchmark.plots import episode_figures
+    from shipgym.benchmark.report import metrics_tables, paired_table
+    from shipgym.benchmark.runner import _cell
+
+    env_id = "shipgym/RVGTargetTracking-v1"
+    result = evaluate(
+        env_id,
+        make_policy("classic", env_id),
+        "classic",
+        episodes=4,
+        seed=10,
+        progress=_quiet,
+        wrappers=[_BlowUpOnOddSeeds()],
+    )
+    assert result.blown_up == 2
+    assert result.terminations[1] == result.terminations[3] == "numerical_blow_up"
+    assert result.lengths[1] == result.lengths[3] == 3
+    assert result.lengths[0] > 3 and result.terminations[0] != "numerical_blow_up"
+    d = result.to_dict()
+    assert d["blown_up"] == 2 and d["length"] == result.lengths
+    # no aggregate of a cell with a blow-up is a number (it would reward blowing up)
+    assert math.isnan(d["mean_return"]) and d["return_ci95"] is None
+    assert all(math.isnan(v) for v in d["metrics"].values())
+    assert all(ci is None for ci in d["metrics_ci95"].values())
+    assert math.isnan(d["returns"][1]) and math.isfinite(d["returns"][0])
+    assert all(math.isnan(d["per_episode"][k][1]) for k in d["per_episode"])
+    assert _cell(result, "return") == "blew up 2/4"
+    table = "\n".join(metrics_tables([d]))
+    assert "blew up 2/4" in table and "nan" not in table.lower()
+    clean = evaluate(env_id, make_policy("zero", env_id), "zero", episodes=4, seed=10,
+                     progress=_quiet)  # fmt: skip
+    ref = {**clean.to_dict(), "controller": "classic-tuned"}
+    assert "blew up 2/4" in "\n".join(paired_table([d, ref]))
+    # the episode figure says so
+    path, write = episode_figures(result, tmp_path, max_episodes=2)[1]
+    write(path)
+    assert path.stat().st_size > 10_000

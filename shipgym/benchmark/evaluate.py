@@ -25,6 +25,14 @@ Engineering metrics beside them (what a control engineer signs off, not what the
   [MJ];
 * ``cross_track_straight_m``: RMS cross-track error on the straight parts of the legs
   (:data:`STRAIGHT_AFTER_S` after each switch), apart from the turns.
+
+Blown-up episodes. An episode whose state stops being finite ends with the termination reason
+:data:`BLOW_UP` (the env stops it with reward 0, so its return would look better than any real
+run). Its return and metrics are undefined (NaN): the motion after a blow-up is not physical.
+A cell with a blown-up episode has no mean return and no metric means at all (NaN, shown as
+``blew up k/n`` in every table and figure) rather than means over the episodes that survived,
+which would reward a controller for blowing up on its hard cases. Every result carries the
+count (``blown_up``) and each episode's termination reason and length in steps.
 """
 
 from __future__ import annotations
@@ -42,6 +50,11 @@ import numpy as np
 import shipgym  # noqa: F401  (registers the environments)
 from shipgym.benchmark.stats import bootstrap_ci
 from shipgym.envs import ENV_IDS, env_task
+from shipgym.envs.kernels import BLOW_UP as _BLOW_UP_CODE
+from shipgym.envs.kernels import REASONS
+
+#: Termination reason of an episode whose state stopped being finite.
+BLOW_UP = REASONS[_BLOW_UP_CODE]
 
 _WEAR = ("rudder_travel_deg_min", "rudder_reversals_min")
 _TASK_METRICS: dict[str, tuple[str, ...]] = {
@@ -111,6 +124,18 @@ class EvaluationResult:
     condition: str = "nominal"
     #: How each episode ended (``info["termination_reason"]`` of its last step).
     terminations: list[str] = field(default_factory=list)
+    #: Steps of each episode.
+    lengths: list[int] = field(default_factory=list)
+
+    @property
+    def blown_up(self) -> int:
+        """Episodes that ended in a numerical blow-up (:data:`BLOW_UP`)."""
+        return self.terminations.count(BLOW_UP)
+
+    @property
+    def mean_return(self) -> float:
+        """Mean return; NaN if any episode blew up (see the module docstring)."""
+        return math.nan if self.blown_up else float(np.mean(self.returns))
 
     def values(self, key: str) -> np.ndarray:
         """Per-episode values of a metric (NaN where undefined: never settled)."""
@@ -121,7 +146,7 @@ class EvaluationResult:
         for k in METRICS[self.env]:
             v = self.values(k)
             v = v[np.isfinite(v)]
-            out[k] = float(fn(v)) if v.size else math.nan
+            out[k] = float(fn(v)) if v.size and not self.blown_up else math.nan
         return out
 
     @property
@@ -146,22 +171,27 @@ class EvaluationResult:
         out: dict[str, list[float] | None] = {}
         for k in METRICS[self.env]:
             v = self.values(k)
-            out[k] = list(bootstrap_ci(v)) if np.isfinite(v).sum() >= 2 else None
+            defined = np.isfinite(v).sum() >= 2 and not self.blown_up
+            out[k] = list(bootstrap_ci(v)) if defined else None
         return out
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object: env, controller, condition, episodes, mean/std return and its
         bootstrap 95 % interval, each metric's mean, std, interval and number of episodes
-        that define it, and the per-episode returns and metrics (for paired comparisons)."""
+        that define it, the per-episode returns and metrics (for paired comparisons), each
+        episode's termination reason and length, and the number of blown-up episodes (every
+        aggregate is NaN if there is one)."""
+        valid = self.episodes > 1 and not self.blown_up
         return {
             "env": self.env,
             "controller": self.controller,
             "condition": self.condition,
             "episodes": self.episodes,
             "seed": self.seed,
-            "mean_return": float(np.mean(self.returns)),
-            "std_return": float(np.std(self.returns)),
-            "return_ci95": list(bootstrap_ci(self.returns)) if self.episodes > 1 else None,
+            "mean_return": self.mean_return,
+            "std_return": float(np.std(self.returns)) if not self.blown_up else math.nan,
+            "return_ci95": list(bootstrap_ci(self.returns)) if valid else None,
+            "blown_up": self.blown_up,
             "metrics": self.metrics,
             "metrics_std": self.metrics_std,
             "metrics_ci95": self.metrics_ci95,
@@ -169,6 +199,7 @@ class EvaluationResult:
             "returns": [float(r) for r in self.returns],
             "per_episode": {k: [float(x) for x in self.values(k)] for k in METRICS[self.env]},
             "termination": list(self.terminations),
+            "length": list(self.lengths),
             "options": self.options,
         }
 
@@ -389,12 +420,17 @@ def evaluate(
     def finish(log: EpisodeLog, targets: list[np.ndarray]) -> None:
         if targets:
             log.extras["target"] = np.asarray(targets)
-        metrics = episode_metrics(env_id, log, dt)
         logs.append(log)
+        head = f"{env_id} {controller} episode {len(logs)}/{episodes} (seed {log.seed}): "
+        if log.info[-1]["termination_reason"] == BLOW_UP:
+            per_episode.append(dict.fromkeys(METRICS[env_id], math.nan))
+            progress(head + f"numerical blow-up at step {len(log.time)}: no return, no metrics")
+            return
+        metrics = episode_metrics(env_id, log, dt)
         per_episode.append(metrics)
         progress(
-            f"{env_id} {controller} episode {len(logs)}/{episodes} (seed {log.seed}): "
-            f"return {log.episode_return:.1f}, "
+            head
+            + f"return {log.episode_return:.1f}, "
             + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
         )
 
@@ -439,10 +475,14 @@ def evaluate(
         controller=controller,
         episodes=episodes,
         seed=seed,
-        returns=[log.episode_return for log in logs],
+        returns=[
+            math.nan if log.info[-1]["termination_reason"] == BLOW_UP else log.episode_return
+            for log in logs
+        ],
         per_episode=per_episode,
         logs=logs,
         options=dict(reset_options or {}),
         condition=condition,
         terminations=[str(log.info[-1]["termination_reason"]) for log in logs],
+        lengths=[len(log.time) for log in logs],
     )

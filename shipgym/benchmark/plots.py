@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from shipgym.benchmark.evaluate import HEADING_ENVS, EpisodeLog, EvaluationResult
+from shipgym.benchmark.evaluate import BLOW_UP, HEADING_ENVS, EpisodeLog, EvaluationResult
 from shipgym.envs import env_task
 
 _TASK_SIGNAL = {
@@ -78,9 +78,16 @@ def plot_episode(result: EvaluationResult, log: EpisodeLog, path: str | Path) ->
     ax.set_xlabel("time [s]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    reason = log.info[-1]["termination_reason"]
+    outcome = (
+        f"NUMERICAL BLOW-UP at step {len(log.time)} (no return, no metrics)"
+        if reason == BLOW_UP
+        else f"return {log.episode_return:.1f}"
+    )
     fig.suptitle(
-        f"{result.env}, controller {result.controller}: return {log.episode_return:.1f}",
+        f"{result.env}, controller {result.controller}: {outcome}",
         fontsize=12,
+        color="#c0392b" if reason == BLOW_UP else "black",
     )
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -164,6 +171,20 @@ def plot_benchmark_metrics(benchmark: Any, path: str | Path) -> Path:
                 capsize=2,
                 color=[_colour(n) for n in names],
             )
+            for x, n in enumerate(names):
+                result = benchmark.get(env_id, n, "nominal")
+                if result.blown_up:  # no bar: its mean is undefined
+                    label = f"blew up {result.blown_up}/{result.episodes}"
+                    ax.text(
+                        x,
+                        0.0,
+                        label,
+                        rotation=90,
+                        ha="center",
+                        va="bottom",
+                        fontsize=7,
+                        color="#c0392b",
+                    )
             ax.set_xticks(range(len(names)), names, fontsize=7, rotation=30)
             better = "higher" if key == "return" or key in HIGHER_IS_BETTER else "lower"
             title = f"{key} ({better} better)"
@@ -205,6 +226,9 @@ def plot_benchmark_robustness(benchmark: Any, path: str | Path) -> Path:
                 for k, c in enumerate(conds)
                 if _has(benchmark, env_id, name, c)
             ]
+            for k, c in enumerate(conds):
+                if _has(benchmark, env_id, name, c) and benchmark.get(env_id, name, c).blown_up:
+                    ax.plot(k, 0.0, "x", color=_colour(name), ms=9, mew=2)  # no mean: marked
             if len(pts) < 2:
                 continue
             k, m, lo, hi = (np.array(v) for v in zip(*pts, strict=True))
@@ -222,7 +246,7 @@ def plot_benchmark_robustness(benchmark: Any, path: str | Path) -> Path:
         ax.set_xticks(range(len(conds)), conds, fontsize=7, rotation=35)
         ax.set_title(env_id.split("/")[-1], fontsize=9)
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("mean return (95 % interval)")
+    axes[0].set_ylabel("mean return (95 % interval); x: blew up, no mean")
     axes[0].legend(fontsize=7)
     fig.suptitle("robustness: the same seeds in every condition", fontsize=11)
     path = Path(path)

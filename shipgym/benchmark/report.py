@@ -35,6 +35,11 @@ def _ci_cell(mean: float, ci: Sequence[float] | None, defined: int | None, episo
     return cell
 
 
+def _blew_up(e: dict[str, Any]) -> str | None:
+    """``blew up k/n`` for an evaluation with blown-up episodes (its aggregates are undefined)."""
+    return f"blew up {e['blown_up']}/{e['episodes']}" if e.get("blown_up") else None
+
+
 def _label(env_id: str) -> str:
     return env_id.split("/")[-1]
 
@@ -57,11 +62,14 @@ def metrics_tables(entries: Sequence[dict[str, Any]], condition: str = "nominal"
         ]
         for e in rows:
             n = e["episodes"]
-            cells = [_ci_cell(e["mean_return"], e.get("return_ci95"), None, n)]
-            cells += [
-                _ci_cell(e["metrics"][k], e["metrics_ci95"][k], e["metrics_defined"][k], n)
-                for k in keys
-            ]
+            if _blew_up(e):
+                cells = [f"**{_blew_up(e)}**"] + ["—"] * len(keys)
+            else:
+                cells = [_ci_cell(e["mean_return"], e.get("return_ci95"), None, n)]
+                cells += [
+                    _ci_cell(e["metrics"][k], e["metrics_ci95"][k], e["metrics_defined"][k], n)
+                    for k in keys
+                ]
             lines.append(f"| {e['controller']} | " + " | ".join(cells) + " |")
         lines.append("")
     return lines
@@ -96,11 +104,15 @@ def paired_metrics_tables(
         for (env, name, cond), e in by_key.items():
             if (env, cond) != (env_id, condition) or name == reference:
                 continue
-            cells = [_paired_cell(e["returns"], ref["returns"], True)]
-            cells += [
-                _paired_cell(e["per_episode"][k], ref["per_episode"][k], k in HIGHER_IS_BETTER)
-                for k in keys
-            ]
+            if _blew_up(e) or _blew_up(ref):
+                blew = f"**{_blew_up(e) or reference + ' ' + str(_blew_up(ref))}**"
+                cells = [blew] + ["—"] * len(keys)
+            else:
+                cells = [_paired_cell(e["returns"], ref["returns"], True)]
+                cells += [
+                    _paired_cell(e["per_episode"][k], ref["per_episode"][k], k in HIGHER_IS_BETTER)
+                    for k in keys
+                ]
             body.append(f"| {name} | " + " | ".join(cells) + " |")
         if body:
             lines += [
@@ -137,10 +149,16 @@ def robustness_table(entries: Sequence[dict[str, Any]]) -> list[str]:
             cells = []
             for cond in others:
                 e = by_key.get((env_id, name, cond))
-                cells.append(
-                    "—" if e is None else f"{e['mean_return']:.3g} ({e['mean_return'] - base:+.3g})"
-                )
-            lines.append(f"| {_label(env_id)} | {name} | {base:.3g} | " + " | ".join(cells) + " |")
+                if e is None:
+                    cells.append("—")
+                elif _blew_up(e):
+                    cells.append(f"**{_blew_up(e)}**")
+                elif _blew_up(nominal):
+                    cells.append(f"{e['mean_return']:.3g}")
+                else:
+                    cells.append(f"{e['mean_return']:.3g} ({e['mean_return'] - base:+.3g})")
+            first = f"**{_blew_up(nominal)}**" if _blew_up(nominal) else f"{base:.3g}"
+            lines.append(f"| {_label(env_id)} | {name} | {first} | " + " | ".join(cells) + " |")
     return [*lines, ""]
 
 
@@ -154,6 +172,10 @@ def paired_table(entries: Sequence[dict[str, Any]], reference: str = REFERENCE) 
         if name == reference or ref is None or "returns" not in e or "returns" not in ref:
             continue
         if len(e["returns"]) < 2 or len(e["returns"]) != len(ref["returns"]):
+            continue
+        if _blew_up(e) or _blew_up(ref):
+            blew = _blew_up(e) or f"{reference} {_blew_up(ref)}"
+            rows.append(f"| {_label(env_id)} | {cond} | {name} | **{blew}** | — | — |")
             continue
         mean, lo, hi = paired_difference(e["returns"], ref["returns"])
         rows.append(

@@ -160,6 +160,7 @@ class BenchmarkResult:
                 "episodes": r.episodes,
                 "seed": r.seed,
                 "current_speed": r.options.get("current_speed", ""),
+                "blown_up": r.blown_up,
             }
             rows.append(
                 {**base, "metric": "return", "mean": d["mean_return"], "std": d["std_return"]}
@@ -216,6 +217,8 @@ class BenchmarkResult:
 
 
 def _cell(result: EvaluationResult, key: str) -> str:
+    if result.blown_up:
+        return f"blew up {result.blown_up}/{result.episodes}" if key == "return" else "-"
     d = result.to_dict()
     if key == "return":
         return f"{d['mean_return']:.1f} +- {d['std_return']:.1f}"
@@ -374,10 +377,9 @@ def run_benchmark(
 
     def report(result: EvaluationResult, seconds: float) -> None:
         results.append(result)
-        d = result.to_dict()
         progress(
             f"[{len(results)}/{len(cells)}] {result.env} {result.controller} {result.condition}: "
-            f"return {d['mean_return']:.1f} +- {d['std_return']:.1f} ({seconds:.1f} s)"
+            f"return {_cell(result, 'return')} ({seconds:.1f} s)"
         )
 
     if jobs == 1:

@@ -167,8 +167,10 @@ def tune(
         returns = np.asarray(result.returns)
         row = {
             "design": dict(design),
-            "mean_return": float(returns.mean()),
-            "std_return": float(returns.std()),
+            # a design that blows up in any episode never wins (its returns are undefined)
+            "mean_return": -math.inf if result.blown_up else float(returns.mean()),
+            "std_return": math.nan if result.blown_up else float(returns.std()),
+            "blown_up": result.blown_up,
         }
         rows.append(row)
         progress(
