@@ -57,6 +57,8 @@ class NomotoHeadingEnv(ShipEnv):
     Truncation after 800 steps (800 s) through ``max_episode_steps``. Termination only if the
     integration blows up (``info["termination_reason"] == "numerical_blow_up"``; the last finite
     observation is returned).
+    Once ``terminated`` is returned, a further ``step`` raises ``gymnasium.error.ResetNeeded``
+    until ``reset``.
 
     ## Arguments
 
@@ -68,6 +70,15 @@ class NomotoHeadingEnv(ShipEnv):
     ``info`` holds ``state`` (names in ``env.unwrapped.state_names``), ``current_speed``,
     ``current_direction``, ``heading_error``, ``heading_setpoint`` and ``termination_reason``.
 
+    Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
+    range), from the ship's top speed V = 9.9 m/s (at the largest shaft speed) and length
+    L = 160.9 m: ``current_speed`` in [0, 9.9] m/s (also the largest ``max_current_speed``);
+    ``current_direction``, ``setpoints`` and the heading ``psi`` within +-628.4 rad (100 turns);
+    ``initial_state`` positions ``x``, ``y`` within +-7920 m (one episode at top speed),
+    ``U`` in [0, 14.85] m/s (1.5 V), ``r`` within +-0.1231 rad/s (2 V / L: the bow sideways
+    at top speed), ``r_dot`` within +-0.1231 rad/s^2, ``delta`` within +-0.6109 rad (the
+    steering gear's limit). ``env.unwrapped.task.state_ranges()`` lists them.
+
     ## Version History
 
     * v0: Initial version.
@@ -77,7 +88,7 @@ class NomotoHeadingEnv(ShipEnv):
 
     @property
     def ship_dimensions(self) -> tuple[float, float]:
-        return (160.9, 23.2)
+        return (NomotoHeadingTask.ship_length, NomotoHeadingTask.ship_beam)
 
     def _draw_args(self, i: int) -> dict[str, Any]:
         return {"setpoint_heading": float(self.task.metrics(i)["heading_setpoint"])}
@@ -131,12 +142,24 @@ class RVGHeadingEnv(ShipEnv):
     ## Episode End
 
     Truncation after 600 steps (300 s); termination only on a numerical blow-up.
+    Once ``terminated`` is returned, a further ``step`` raises ``gymnasium.error.ResetNeeded``
+    until ``reset``.
 
     ## Arguments
 
     ``gymnasium.make("shipgym/RVGHeading-v0", max_current_speed=0.5, max_azimuth=0.61,
     setpoint_interval=100.0, params="seed001", render_mode=None)``. Reset options and
-    ``info`` as for ``NomotoHeading-v0``.
+    ``info`` as for ``NomotoHeading-v0``, with the Gunnerus' ``initial_state`` (``x``, ``y``,
+    ``psi``, ``u``, ``v``, ``r``, ``T1``, ``T2``, ``alpha1``, ``alpha2``).
+
+    Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
+    range), from the top speed V = 8.7 m/s (``thrust_zero_speed``: the pods push no more above
+    it) and L = 33.9 m: ``current_speed`` in [0, 8.7] m/s (also the largest
+    ``max_current_speed``); ``current_direction``, ``setpoints`` and ``psi`` within +-628.4 rad
+    (100 turns); ``x``, ``y`` within +-2610 m (one episode at top speed); ``u``, ``v`` within
+    +-13.05 m/s (1.5 V); ``r`` within +-0.5133 rad/s (2 V / L); ``T1``, ``T2`` in [0, 121700] N
+    (the bollard thrust; [0, 85070] N with ``"sea_trials"``); ``alpha1``, ``alpha2`` within
+    +-3.142 rad (``azimuth_max``). ``env.unwrapped.task.state_ranges()`` lists them.
     ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
     trials, the default of ``-v1``) or an ``RVGParams``.

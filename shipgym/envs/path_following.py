@@ -45,8 +45,8 @@ class RVGPathFollowingEnv(ShipEnv):
 
     ``0.5 clip(progress / (5.14 m/s dt), -1, 1) + 0.5 exp(-(e / 25 m)^2) - 0.1 |chi_p - psi| / pi
     - 0.05 |a|^2`` per step (at most 1; positive while the ship is near the path and making way
-    along it, so ending an episode early never pays), +20 on reaching the last waypoint, -20
-    when the cross-track error exceeds ``max_cross_track``.
+    along it, so ending an episode early never pays; at least -0.7), +20 on reaching the last
+    waypoint, -20 when the cross-track error exceeds ``max_cross_track``: in [-20.7, 21].
 
     ## Starting State
 
@@ -58,6 +58,8 @@ class RVGPathFollowingEnv(ShipEnv):
 
     Terminates on reaching the last waypoint (``info["completed"]``), on a cross-track error
     beyond ``max_cross_track`` (250 m) or a numerical blow-up; truncation after 1600 steps.
+    Once ``terminated`` is returned, a further ``step`` raises ``gymnasium.error.ResetNeeded``
+    until ``reset``.
 
     ## Arguments
 
@@ -66,6 +68,9 @@ class RVGPathFollowingEnv(ShipEnv):
     ``current_speed``, ``current_direction``, ``initial_state``, ``waypoints`` (2 to 16
     (north, east) points [m]). ``info`` holds ``state``, the current, ``cross_track_error``,
     ``segment``, ``completed`` and ``termination_reason``.
+    Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
+    range) as for ``RVGHeading-v0``, but positions (``x``, ``y`` and every waypoint's north
+    and east) within +-6960 m, the distance covered in one episode at the top speed 8.7 m/s.
     ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
     trials, the default of ``-v1``) or an ``RVGParams``.

@@ -35,7 +35,8 @@ class RVGSpeedEnv(ShipEnv):
 
     ## Rewards
 
-    ``-|u_d - u_r| / 2 - 0.05 (T / T_bollard)^2`` per step.
+    ``-|u_d - u_r| / 2 - 0.05 (T / T_bollard)^2`` per step, with the speed error and the thrust
+    fraction of the observation (clipped to +-25 m/s and [0, 1]): in [-12.55, 0].
 
     ## Starting State
 
@@ -45,14 +46,23 @@ class RVGSpeedEnv(ShipEnv):
     ## Episode End
 
     Truncation after 800 steps (400 s); termination only on a numerical blow-up.
+    Once ``terminated`` is returned, a further ``step`` raises ``gymnasium.error.ResetNeeded``
+    until ``reset``.
 
     ## Arguments
 
     ``gymnasium.make("shipgym/RVGSpeed-v0", max_current_speed=0.5, setpoint_interval=200.0,
     params="seed001", render_mode=None)``. Reset options: ``current_speed``,
     ``current_direction``,
-    ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s] >= 0). ``info`` holds ``state``,
+    ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s]). ``info`` holds ``state``,
     the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.
+    Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
+    range) as for ``RVGHeading-v0``, from the top speed V = 8.7 m/s (``thrust_zero_speed``),
+    but positions ``x``, ``y`` within +-3480 m (one episode at top speed) and ``setpoints`` in
+    [0, 8.7] m/s (no speed through the water above V is reachable): ``current_speed`` in
+    [0, 8.7] m/s, ``current_direction`` and ``psi`` within +-628.4 rad, ``u``, ``v`` within
+    +-13.05 m/s (1.5 V), ``r`` within +-0.5133 rad/s, ``T1``, ``T2`` in [0, 121700] N (bollard;
+    [0, 85070] N with ``"sea_trials"``), ``alpha1``, ``alpha2`` within +-3.142 rad.
     ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
     trials, the default of ``-v1``) or an ``RVGParams``.

@@ -39,7 +39,7 @@ class RVGTargetTrackingEnv(ShipEnv):
     ## Rewards
 
     ``1 - min(|d - d_set| / 100 m, 2) - 0.05 |a|^2`` per step (positive within 100 m of the set
-    distance); -20 when the distance exceeds ``max_distance``.
+    distance, at least -1.1); -20 when the distance exceeds ``max_distance``: in [-21.1, 1].
 
     ## Starting State
 
@@ -50,6 +50,8 @@ class RVGTargetTrackingEnv(ShipEnv):
 
     Terminates when the distance exceeds ``max_distance`` (3 km) or on a numerical blow-up;
     truncation after 1600 steps (800 s).
+    Once ``terminated`` is returned, a further ``step`` raises ``gymnasium.error.ResetNeeded``
+    until ``reset``.
 
     ## Arguments
 
@@ -58,6 +60,11 @@ class RVGTargetTrackingEnv(ShipEnv):
     ``current_direction``, ``initial_state``, ``target_position`` and ``target_velocity``
     ((north, east) in m and m/s), ``distance`` [m]. ``info`` holds ``state``, the current,
     ``distance``, ``distance_error`` and ``termination_reason``.
+    Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
+    range) as for ``RVGHeading-v0``, but positions (``x``, ``y`` and ``target_position``'s
+    north and east) within +-6960 m (one episode at the top speed 8.7 m/s, or ``max_distance``
+    if larger); ``target_velocity`` a speed in [0, 13.05] m/s (1.5 times the top speed) and
+    ``distance`` in (0, ``max_distance``].
     ``params`` selects the Gunnerus parameter set: ``"seed001"`` (seed 001, the default of ``-v0``),
     ``"sea_trials"`` (:meth:`shipgym.models.RVGParams.sea_trials`, identified from the sea
     trials, the default of ``-v1``) or an ``RVGParams``.

@@ -10,6 +10,26 @@ single environment seeded with ``s`` exactly, and autoresets of many sub-envs co
 Current in ``reset(options=...)``: ``current_speed`` [m/s, >= 0] and ``current_direction``
 [rad, the direction the water moves toward, clockwise from north]. Without them the speed is
 drawn uniformly from ``[0, max_current_speed]`` and the direction uniformly from [-pi, pi).
+
+Every reset option has a physical range, and a value outside it raises ``ValueError`` naming
+the option, the value and the range (nothing changes then). The ranges come from the ship and
+the task: its top speed ``V`` (the Gunnerus' ``thrust_zero_speed``, 8.7 m/s, where its pods
+can push no more; the Mariner's speed at its largest shaft speed, 9.9 m/s), its length ``L``
+and the distance it covers in one episode at top speed (:attr:`Task.arena`):
+
+* speeds of the ship and of a target: ``|.| <= SPEED_FACTOR V`` (1.5 V); a Nomoto ``U`` >= 0;
+* current and speed setpoints: ``[0, V]`` (no current faster than the ship, no setpoint it
+  cannot reach);
+* yaw rate: ``|r| <= 2 V / L`` (the bow moving sideways at top speed); a yaw acceleration
+  that rate per second;
+* positions (ship, waypoints, target): ``|x|, |y| <= arena``;
+* angles (headings, heading setpoints, current direction): ``|.| <= MAX_ANGLE`` (100 whole
+  turns, so an unwrapped heading from a long run is accepted);
+* actuators: the rudder within the steering gear's limit, pod thrust in ``[0, bollard]``,
+  pod azimuth within ``azimuth_max``.
+
+:meth:`Task.state_ranges` gives the range of each state; range ends are rounded to the four
+significant digits the messages show.
 """
 
 from __future__ import annotations
@@ -28,6 +48,10 @@ from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEE
 
 COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
 _N_COMMON_DRAWS = 2
+#: Largest angle [rad] a reset option may give (heading, setpoint, current direction): 100 turns.
+MAX_ANGLE = 200.0 * math.pi
+#: Ship and target speeds given at reset may reach this multiple of the ship's top speed.
+SPEED_FACTOR = 1.5
 
 
 def _finite_float(name: str, value: Any) -> float:
@@ -66,6 +90,42 @@ def _positive(name: str, value: float) -> float:
     return float(value)
 
 
+def _limit(value: float) -> float:
+    """A range end rounded away from zero to the 4 significant digits a message shows."""
+    if value == 0.0:
+        return 0.0
+    exp = math.floor(math.log10(abs(value))) - 3
+    digits = math.ceil(abs(value) / 10.0**exp - 1e-9)
+    return math.copysign(float(f"{digits}e{exp}"), value)
+
+
+def _check_range(name: str, value: Any, low: float, high: float, unit: str) -> None:
+    """Raise ``ValueError`` naming option ``name``, ``value`` and the range unless every entry
+    of ``value`` is in ``[low, high]``."""
+    arr = np.asarray(value, dtype=np.float64)
+    if not np.all((arr >= low) & (arr <= high)):
+        got = arr.tolist() if arr.ndim else float(arr)
+        raise ValueError(f"option {name} must be in [{low:g}, {high:g}] {unit}, got {got!r}")
+
+
+#: Unit of each state in the messages of the ``initial_state`` option.
+_STATE_UNITS = {
+    "x": "m",
+    "y": "m",
+    "psi": "rad",
+    "u": "m/s",
+    "v": "m/s",
+    "U": "m/s",
+    "r": "rad/s",
+    "r_dot": "rad/s^2",
+    "delta": "rad",
+    "T1": "N",
+    "T2": "N",
+    "alpha1": "rad",
+    "alpha2": "rad",
+}
+
+
 def _uniform(u: np.ndarray, low: float, high: float) -> np.ndarray:
     return low + (high - low) * u
 
@@ -93,6 +153,10 @@ class Task:
     obs_names: ClassVar[tuple[str, ...]]
     #: Observation bounds (low, high) per entry; observations are clipped to them.
     obs_bounds: ClassVar[tuple[tuple[float, float], ...]]
+    #: Bounds (low, high) of the reward of every step, whatever the state.
+    reward_bounds: ClassVar[tuple[float, float]]
+    #: Length [m] of the ship, for the yaw-rate range of the reset options.
+    ship_length: ClassVar[float]
 
     def __init__(self, n: int, model: ShipModel, max_current_speed: float) -> None:
         if not isinstance(n, int | np.integer) or n < 1:
@@ -103,6 +167,11 @@ class Task:
             )
         self.n = int(n)
         self.model = model
+        if max_current_speed > self.top_speed:
+            raise ValueError(
+                f"max_current_speed must be in [0, {self.top_speed:g}] m/s (the ship's top "
+                f"speed), got {max_current_speed!r}"
+            )
         self.max_current_speed = float(max_current_speed)
         self.x = np.zeros((n, model.nx))
         self.u = np.zeros((n, model.nu))
@@ -124,6 +193,47 @@ class Task:
     def n_draws(self) -> int:
         """Uniform numbers drawn from a row's generator at each reset."""
         return _N_COMMON_DRAWS + self.n_task_draws
+
+    # --- ranges of the reset options ---------------------------------------------------------
+    @property
+    def top_speed(self) -> float:
+        """Top speed [m/s] of the ship through the water; also the largest current."""
+        raise NotImplementedError
+
+    @property
+    def speed_limit(self) -> float:
+        """Largest ship or target speed [m/s] a reset option may give."""
+        return _limit(SPEED_FACTOR * self.top_speed)
+
+    @property
+    def yaw_rate_limit(self) -> float:
+        """Largest yaw rate [rad/s] a reset option may give: the bow sideways at top speed."""
+        return _limit(2.0 * self.top_speed / self.ship_length)
+
+    @property
+    def arena(self) -> float:
+        """Largest north or east coordinate [m] of a position given at reset: the distance the
+        ship covers in one episode at top speed."""
+        return _limit(self.max_episode_steps * self.dt * self.top_speed)
+
+    def state_ranges(self) -> dict[str, tuple[float, float]]:
+        """Accepted range (low, high) of each state of the ``initial_state`` option."""
+        a, v, r = self.arena, self.speed_limit, self.yaw_rate_limit
+        ranges = {
+            "x": (-a, a),
+            "y": (-a, a),
+            "psi": (-_limit(MAX_ANGLE), _limit(MAX_ANGLE)),
+            "u": (-v, v),
+            "v": (-v, v),
+            "U": (0.0, v),
+            "r": (-r, r),
+            "r_dot": (-r, r),
+            **self._actuator_ranges(),
+        }
+        return {name: ranges[name] for name in self.model.state_names}
+
+    def _actuator_ranges(self) -> dict[str, tuple[float, float]]:
+        raise NotImplementedError
 
     # --- provided by each task ---------------------------------------------------------------
     def _kernel_args(self) -> tuple[Any, ...]:
@@ -249,16 +359,31 @@ class Task:
                 a[...] = old
 
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
-        """Raise ``ValueError`` for a bad task option before anything is changed."""
+        """Raise ``ValueError`` for a bad option before anything is changed.
+
+        Checks the ranges of the current options here; a task adds its own options' checks.
+        """
+        if "current_speed" in options:
+            speed = _finite_float("current_speed", options["current_speed"])
+            _check_range("'current_speed'", speed, 0.0, self.top_speed, "m/s")
+        if "current_direction" in options:
+            direction = _finite_float("current_direction", options["current_direction"])
+            _check_range("'current_direction'", direction, *self.state_ranges()["psi"], "rad")
 
     def _apply_initial_state(self, value: Any, states: np.ndarray) -> None:
-        """Override drawn ``states``: a dict sets the named states, a vector the whole state."""
+        """Override drawn ``states``: a dict sets the named states, a vector the whole state.
+
+        Each state must be in its :meth:`state_ranges` range.
+        """
         names = self.model.state_names
+        ranges = self.state_ranges()
         if isinstance(value, Mapping):
             for key, v in value.items():
                 if key not in names:
                     raise ValueError(f"initial_state has unknown state {key!r}; states: {names}")
-                states[:, names.index(key)] = _finite_float(f"initial_state[{key!r}]", v)
+                f = _finite_float(f"initial_state[{key!r}]", v)
+                _check_range(f"initial_state[{key!r}]", f, *ranges[key], _STATE_UNITS[key])
+                states[:, names.index(key)] = f
             return
         try:
             arr = np.asarray(value, dtype=np.float64)
@@ -269,6 +394,8 @@ class Task:
                 f"initial_state must be a dict of named states or {len(names)} finite values "
                 f"{names}, got {value!r}"
             )
+        for key, f in zip(names, arr.tolist(), strict=True):
+            _check_range(f"initial_state[{key!r}]", f, *ranges[key], _STATE_UNITS[key])
         states[:] = arr
 
     def info(self, i: int) -> dict[str, Any]:
@@ -334,8 +461,10 @@ class HeadingTask(ScheduleMixin, Task):
         return (self.ipsi, self.obs_idx, self.schedule, self.hold_steps)
 
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
+        super()._validate_task_options(options)
         if "setpoints" in options:
-            _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
+            sp = _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
+            _check_range("'setpoints'", sp, *self.state_ranges()["psi"], "rad")
 
     def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
         if "setpoints" in options:
@@ -367,6 +496,9 @@ class NomotoHeadingTask(HeadingTask):
     obs_state_names = ("r", "delta")
     obs_names = ("heading_error", "r", "delta")
     obs_bounds = ((-math.pi, math.pi), (-0.5, 0.5), (-math.pi / 2, math.pi / 2))
+    reward_bounds = (-1.05, 0.0)
+    ship_length = 160.9  # [m], the Mariner class cargo ship
+    ship_beam = 23.2  # [m]
 
     def __init__(
         self,
@@ -384,6 +516,18 @@ class NomotoHeadingTask(HeadingTask):
         self.B[0, 0] = gear.max_angle
         self.service_speed = surge.service_speed
 
+    @property
+    def top_speed(self) -> float:
+        """Speed [m/s] at the largest shaft speed (9.9 m/s for the Mariner)."""
+        surge = self.model.surge
+        assert surge is not None
+        return _limit(surge.gain * surge.max_shaft_speed)
+
+    def _actuator_ranges(self) -> dict[str, tuple[float, float]]:
+        gear = self.model.gear
+        assert gear is not None
+        return {"delta": (-_limit(gear.max_angle), _limit(gear.max_angle))}
+
     def _initial_states(self, draws: np.ndarray) -> np.ndarray:
         x = np.zeros((draws.shape[0], self.model.nx))
         x[:, self.ipsi] = _uniform(draws[:, 0], -math.pi, math.pi)
@@ -399,8 +543,21 @@ class RVGMixin:
     """
 
     dt = 0.5
+    ship_length = LPP
     x: np.ndarray
     c: np.ndarray
+    model: ShipModel
+
+    @property
+    def top_speed(self) -> float:
+        """``thrust_zero_speed`` [m/s]: above it the pods push no more (8.7 m/s)."""
+        return _limit(self.model.params.thrust_zero_speed)
+
+    def _actuator_ranges(self) -> dict[str, tuple[float, float]]:
+        params = self.model.params
+        thrust = (0.0, _limit(params.bollard_thrust))
+        azimuth = (-_limit(params.azimuth_max), _limit(params.azimuth_max))
+        return {"T1": thrust, "T2": thrust, "alpha1": azimuth, "alpha2": azimuth}
 
     def _setup_rvg(self, max_azimuth: float) -> None:
         if not (math.isfinite(max_azimuth) and 0 < max_azimuth <= math.pi):
@@ -449,6 +606,7 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
         (-10.0, 15.0),
         (-10.0, 10.0),
     )
+    reward_bounds = (-1.05, 0.0)
 
     def __init__(
         self,
@@ -485,6 +643,8 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
     task_options = frozenset({"setpoints"})
     obs_names = ("speed_error", "u_r", "thrust_fraction", "speed_setpoint")
     obs_bounds = ((-25.0, 25.0), (-10.0, 15.0), (0.0, 1.0), (0.0, 15.0))
+    #: The speed error in the reward is that of the observation, clipped to +-25 m/s.
+    reward_bounds = (-12.55, 0.0)
     speed_range = (1.5, 6.0)
 
     def __init__(
@@ -510,10 +670,10 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
         return self._rvg_states(psi, _uniform(draws[:, 1], 0.0, 5.0), 0.0)
 
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
+        super()._validate_task_options(options)
         if "setpoints" in options:
             sp = _finite_vector("setpoints", options["setpoints"], self.max_setpoints)
-            if np.any(sp < 0):
-                raise ValueError(f"option 'setpoints' must be speeds >= 0 m/s, got {sp}")
+            _check_range("'setpoints'", sp, 0.0, self.top_speed, "m/s")
 
     def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
         self._add_current(rows, options)
@@ -561,6 +721,8 @@ class RVGPathTask(RVGMixin, Task):
         (-math.pi, math.pi),
         (0.0, 1.0),
     )
+    #: Per step in [-0.7, 1]; +20 on reaching the last waypoint, -20 on leaving the path.
+    reward_bounds = (-20.7, 21.0)
 
     def __init__(
         self,
@@ -603,6 +765,7 @@ class RVGPathTask(RVGMixin, Task):
         return self._rvg_states(psi, SERVICE_SPEED, self.params.service_thrust)
 
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
+        super()._validate_task_options(options)
         if "waypoints" in options:
             self._given_path(options["waypoints"])
 
@@ -623,6 +786,7 @@ class RVGPathTask(RVGMixin, Task):
             )
         if np.any(np.hypot(*np.diff(path, axis=0).T) < 1e-6):
             raise ValueError("option 'waypoints' has two consecutive identical waypoints")
+        _check_range("'waypoints'", path, -self.arena, self.arena, "m (north and east)")
         return path
 
     def _random_paths(self, draws: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -721,6 +885,8 @@ class RVGTargetTask(RVGMixin, Task):
         (-math.pi, math.pi),
         (0.0, 1.0),
     )
+    #: Per step in [-1.1, 1]; -20 when the target gets away.
+    reward_bounds = (-21.1, 1.0)
 
     def __init__(
         self,
@@ -747,12 +913,31 @@ class RVGTargetTask(RVGMixin, Task):
         psi = _uniform(draws[:, 0], -math.pi, math.pi)
         return self._rvg_states(psi, SERVICE_SPEED, self.params.service_thrust)
 
+    @property
+    def arena(self) -> float:
+        """As for every task, but at least ``max_distance`` [m]."""
+        return max(super().arena, _limit(self.max_distance))
+
     def _validate_task_options(self, options: Mapping[str, Any]) -> None:
-        for name in ("target_position", "target_velocity"):
-            if name in options:
-                _point(name, options[name])
-        if "distance" in options and _finite_float("distance", options["distance"]) <= 0:
-            raise ValueError(f"option 'distance' must be > 0 m, got {options['distance']!r}")
+        super()._validate_task_options(options)
+        if "target_position" in options:
+            pos = _point("target_position", options["target_position"])
+            _check_range("'target_position'", pos, -self.arena, self.arena, "m (north and east)")
+        if "target_velocity" in options:
+            vel = _point("target_velocity", options["target_velocity"])
+            speed = float(np.hypot(*vel))
+            if not speed <= self.speed_limit:
+                raise ValueError(
+                    f"option 'target_velocity' must have a speed in [0, {self.speed_limit:g}] "
+                    f"m/s, got {vel.tolist()!r} ({speed:.4g} m/s)"
+                )
+        if "distance" in options:
+            distance = _finite_float("distance", options["distance"])
+            if not 0.0 < distance <= self.max_distance:
+                raise ValueError(
+                    f"option 'distance' must be in (0, {self.max_distance:g}] m (up to "
+                    f"max_distance), got {options['distance']!r}"
+                )
 
     def _reset_task(self, rows: np.ndarray, draws: np.ndarray, options: Mapping[str, Any]) -> None:
         self._add_current(rows, options)
