@@ -15,8 +15,11 @@ stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps
 batch, ``False`` only computes the observations of the current state (after a reset); either
 way only the rows listed in ``rows`` get new observations, rewards, flags and ``reason``
 (0 running, 1 numerical blow-up, 2 success, 3 failure). Observations are clipped to the
-observation-space bounds. A row whose state is no longer finite after the step keeps its
-previous observation, gets reward 0 and terminates with reason 1.
+observation-space bounds. A row whose state is no longer finite after the step, or whose
+observation or reward cannot be computed from it (a NaN from an overflow, say a finite position
+of 1e308), keeps its previous observation, gets reward 0 and terminates with reason 1: an
+observation is always finite and inside the observation space. Every reward is bounded by
+construction (each kernel's docstring gives the bounds; the tasks' ``reward_bounds``).
 """
 
 from __future__ import annotations
@@ -87,8 +90,29 @@ def _begin_row(x, i, rew, term, reason):
 
 
 @row_kernel
-def _clip_obs(obs, i, lo, hi):
-    """Clip row ``i`` of the observations to the observation space bounds."""
+def _keep_obs(obs, i, prev):
+    """Copy row ``i`` of the observations into ``prev`` before it is recomputed."""
+    for k in range(obs.shape[1]):
+        prev[k] = obs[i, k]
+
+
+@row_kernel
+def _finish_row(obs, i, lo, hi, prev, rew, term, reason):
+    """Clip row ``i`` of the observations to the observation space bounds.
+
+    A NaN in the observation or the reward (a finite state whose observation overflowed) ends
+    the row as a blow-up: the observation ``prev`` it had before, reward 0.
+    """
+    bad = math.isnan(rew[i])
+    for k in range(obs.shape[1]):
+        if math.isnan(obs[i, k]):
+            bad = True
+    if bad:
+        for k in range(obs.shape[1]):
+            obs[i, k] = prev[k]
+        rew[i] = 0.0
+        term[i] = True
+        reason[i] = BLOW_UP
     for k in range(obs.shape[1]):
         obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
 
@@ -128,7 +152,7 @@ def _heading(
     """Heading task: hold ``schedule[i, steps[i] // hold_steps]``.
 
     Observation ``[ssa(psi_d - psi), x[obs_idx]...]``; reward
-    ``-|psi_d - psi| / pi - 0.05 |a|^2``.
+    ``-|psi_d - psi| / pi - 0.05 |a|^2``, in ``[-1 - 0.05 n_a, 0]`` (``n_a`` actions).
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -139,18 +163,20 @@ def _heading(
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         scratch = np.empty((5, x.shape[1]))
         work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        prev = np.empty(obs.shape[1])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:
                 _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
             if _begin_row(x, i, rew, term, reason):
+                _keep_obs(obs, i, prev)
                 psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
                 e = ssa_scalar(psi_d - x[i, ipsi])
                 obs[i, 0] = e
                 for k in range(obs_idx.shape[0]):
                     obs[i, 1 + k] = x[i, obs_idx[k]]
                 rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
-                _clip_obs(obs, i, obs_lo, obs_hi)
+                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -179,7 +205,8 @@ def _speed(
     """RVG speed task: hold the speed through the water ``u_r`` at the scheduled setpoint.
 
     Observation ``[u_d - u_r, u_r, T_1 / T_bollard, u_d]``; reward
-    ``-|u_d - u_r| / 2 - 0.05 (T_1 / T_bollard)^2``.
+    ``-|u_d - u_r| / 2 - 0.05 (T_1 / T_bollard)^2`` with the speed error and the thrust fraction
+    clipped to their observation bounds (+-25 m/s, [0, 1]), so in ``[-12.55, 0]``.
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -191,11 +218,13 @@ def _speed(
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         scratch = np.empty((5, x.shape[1]))
         work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        prev = np.empty(obs.shape[1])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:
                 _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
             if _begin_row(x, i, rew, term, reason):
+                _keep_obs(obs, i, prev)
                 psi = x[i, 2]
                 ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
                 ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
@@ -204,8 +233,10 @@ def _speed(
                 obs[i, 1] = ur
                 obs[i, 2] = frac
                 obs[i, 3] = ud
-                rew[i] = -abs(ud - ur) / 2.0 - 0.05 * frac * frac
-                _clip_obs(obs, i, obs_lo, obs_hi)
+                e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
+                f = min(max(frac, obs_lo[2]), obs_hi[2])
+                rew[i] = -abs(e) / 2.0 - 0.05 * f * f
+                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -260,8 +291,8 @@ def _path(
     passed it along the track. Observation ``[e, ssa(chi_p - psi), s_left, turn, u, v, r,
     alpha_1, T_1 / T_bollard]``. Reward per step ``0.5 clip(progress / (ref_speed dt), -1, 1)
     + 0.5 exp(-(e / 25 m)^2) - 0.1 |chi_p - psi| / pi - 0.05 |a|^2`` (at most 1, positive while
-    on the path and making way, so ending an episode early never pays); +20 on reaching the
-    last waypoint, -20 when ``|e| > max_cross_track``.
+    on the path and making way, so ending an episode early never pays, and at least
+    ``-0.6 - 0.05 n_a``); +20 on reaching the last waypoint, -20 when ``|e| > max_cross_track``.
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -272,12 +303,14 @@ def _path(
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         scratch = np.empty((5, x.shape[1]))
         work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        prev = np.empty(obs.shape[1])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             s_before = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
             if advance:
                 _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
             if _begin_row(x, i, rew, term, reason):
+                _keep_obs(obs, i, prev)
                 e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
                 progress = s_before - s_left
                 k = seg[i]
@@ -314,7 +347,7 @@ def _path(
                     - 0.05 * _action_cost(a, i)
                     + bonus
                 )
-                _clip_obs(obs, i, obs_lo, obs_hi)
+                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -346,8 +379,8 @@ def _target(
 
     Observation ``[dx_b, dy_b, dvx_b, dvy_b, |p_t - p| - d_set, u, v, r, alpha_1, T_1 / T_b]``
     with the target's relative position and velocity in the body frame. Reward
-    ``1 - min(|d - d_set| / 100, 2) - 0.05 |a|^2`` (positive within 100 m of the set distance);
-    -20 and termination when the distance exceeds ``max_distance``.
+    ``1 - min(|d - d_set| / 100, 2) - 0.05 |a|^2`` (positive within 100 m of the set distance,
+    at least ``-1 - 0.05 n_a``); -20 and termination when the distance exceeds ``max_distance``.
     """
     if advance:
         bad = first_nonfinite_row(a)
@@ -358,6 +391,7 @@ def _target(
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         scratch = np.empty((5, x.shape[1]))
         work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        prev = np.empty(obs.shape[1])
         for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
             i = rows[j]
             if advance:
@@ -365,6 +399,7 @@ def _target(
                 target[i, 0] += target_vel[i, 0] * dt
                 target[i, 1] += target_vel[i, 1] * dt
             if _begin_row(x, i, rew, term, reason):
+                _keep_obs(obs, i, prev)
                 psi = x[i, 2]
                 cs = math.cos(psi)
                 sn = math.sin(psi)
@@ -391,7 +426,7 @@ def _target(
                     term[i] = True
                     reason[i] = FAILURE
                     rew[i] -= 20.0
-                _clip_obs(obs, i, obs_lo, obs_hi)
+                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
