@@ -25,6 +25,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from shipgym.envs.kernels import REASONS
 from shipgym.envs.tasks import Task
 
 
@@ -63,9 +64,16 @@ class _Spaces:
 
 
 class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
-    """A single ship environment. Subclasses set ``task_cls`` and document the task."""
+    """A single ship environment. Subclasses set ``task_cls`` and document the task.
+
+    Once a step has returned ``terminated=True`` the episode is over: a further ``step``
+    raises Gymnasium's ``ResetNeeded`` until ``reset`` succeeds (no reward is ever paid past
+    the end). Truncation is the ``TimeLimit`` wrapper's business and does not stop the env.
+    """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+    #: Termination reason of the episode that ended, or None while it runs.
+    _ended: str | None = None
 
     def __init__(self, render_mode: str | None = None, **task_kwargs: Any) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -95,6 +103,7 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         self.task.reset_rows([0], [self.np_random], options)
+        self._ended = None
         self._trail = []
         if self._renderer is not None:
             self._renderer.reset_view()
@@ -103,10 +112,17 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
         return self.task.obs[0].astype(np.float32), self.task.info(0)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        if self._ended is not None:
+            raise gym.error.ResetNeeded(
+                f"Cannot call env.step() after the episode terminated (termination_reason "
+                f"{self._ended!r}); call env.reset() first"
+            )
         task = self.task
         task.a[0] = _checked_shape(action, task.a.shape[1:], task.act_dim)
         if task.step() >= 0:
             raise _bad_action(action, task.act_dim, "it holds NaN or infinity")
+        if task.term[0]:
+            self._ended = REASONS[task.reason[0]]
         if self.render_mode == "human":
             self.render()
         return (
