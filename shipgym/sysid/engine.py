@@ -36,6 +36,7 @@ import numpy as np
 
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import Candidate, ModelFamily, get_family, jsonable
+from shipgym.sysid.fit import excitation_problems
 
 __all__ = ["IdentificationResult", "identify"]
 
@@ -139,6 +140,29 @@ def _try(family: ModelFamily, ctx: Any, current: Candidate, name: str) -> Candid
         return exc
 
 
+def _check_excitation(runs: Sequence[Record]) -> None:
+    """Refuse records from which no model is identifiable (every family's fit goes through here).
+
+    The rudder must move and the heading must change (:func:`~shipgym.sysid.fit.
+    excitation_problems`); with several runs, in at least one of them (a straight run beside
+    manoeuvres is fine).
+    """
+    per_run = [excitation_problems(rec.delta, rec.psi) for rec in runs]
+    kinds = [{p.split(" (")[0] for p in problems} for problems in per_run]
+    common = set.intersection(*kinds)
+    if not common:
+        return
+    problems = [p for p in per_run[0] if p.split(" (")[0] in common]
+    if len(runs) > 1:
+        problems = [f"{p} in any of the {len(runs)} runs" for p in sorted(common)]
+    raise ValueError(
+        "not identifiable: no excitation: "
+        + " and ".join(problems)
+        + "; expected a manoeuvre that moves the rudder and turns the ship (zigzag, turning"
+        " circle, pull-out or random rudder)"
+    )
+
+
 def identify(
     record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
@@ -181,8 +205,10 @@ def identify(
     Raises
     ------
     ValueError
-        For a bad ``model``, ``holdout``, ``max_effects`` or ``window_s``, or a record too short
-        to split or lacking the channels the model needs.
+        For a bad ``model``, ``holdout``, ``max_effects`` or ``window_s``, a record too short
+        to split or lacking the channels the model needs, or a record without excitation
+        (``"not identifiable: no excitation: the rudder never moves ..."``: the rudder never
+        moves or the heading never changes, in every run).
     """
     t_start = time.perf_counter()
     family = model if isinstance(model, ModelFamily) else get_family(model)
@@ -210,6 +236,7 @@ def identify(
         isinstance(max_effects, int) and not isinstance(max_effects, bool) and max_effects >= 0
     ):
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
+    _check_excitation(runs)
     window = family.resolve_window(window_s, max(float(r.time[-1] - r.time[0]) for r in runs))
     say = progress or (lambda _msg: None)
     ctx = family.prepare(runs if family.multi_run else runs[0], float(holdout), window)

@@ -41,6 +41,14 @@ once with the per-channel residual RMS (maximum likelihood for Gaussian noise of
 variance per channel). Standard errors are ``s^2 (J^T J)^-1`` at the optimum; they hold for
 white measurement noise and are optimistic when the residual is dominated by model error.
 
+**Excitation.** Both fits (and :func:`shipgym.sysid.engine.identify`, for every model family)
+refuse a record whose rudder never moves or whose heading never changes
+(:func:`check_excitation`: spread between the 1st and 99th percentiles above
+:data:`RUDDER_EXCITATION` / :data:`HEADING_EXCITATION` and above 6 times the noise estimated
+from second differences) with ``ValueError("not identifiable: no excitation: ...")``: without
+input or response the gain and time constant are not identifiable and the optimiser returns
+meaningless values (T of 1e9 s, K of 1e-40 1/s).
+
 **Rudder replay through the shared kernels.** The simulation runs
 :func:`shipgym.models.integrate.rk4_row` (the one model kernel and RK4 integrator) in a
 loop over the record, compiled once per model so that the model dispatch folds away. At each
@@ -84,8 +92,13 @@ from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomot
 
 __all__ = [
     "FIT_MODELS",
+    "HEADING_EXCITATION",
+    "RUDDER_EXCITATION",
+    "YAW_RATE_EXCITATION",
     "FitResult",
     "SysidWarning",
+    "check_excitation",
+    "excitation_problems",
     "fit_equation_error",
     "fit_output_error",
     "regression_data",
@@ -133,6 +146,93 @@ def _check_time(t: npt.ArrayLike, min_samples: int) -> np.ndarray:
     if np.any(np.diff(t) <= 0):
         raise ValueError("t must be strictly increasing (time [s])")
     return t
+
+
+RUDDER_EXCITATION: float = math.radians(0.2)
+"""Smallest rudder spread [rad] (1st to 99th percentile, and 6 times the noise) that counts as
+a moving rudder; below it the yaw dynamics are not identifiable (no input)."""
+
+HEADING_EXCITATION: float = math.radians(0.5)
+"""Smallest heading spread [rad] (1st to 99th percentile, and 6 times the noise) that counts as
+a turning ship; below it the yaw dynamics are not identifiable (no response)."""
+
+YAW_RATE_EXCITATION: float = math.radians(0.05)
+"""Smallest yaw-rate spread [rad/s] that counts as a response when no heading is given."""
+
+
+def _spread_and_noise(a: np.ndarray) -> tuple[float, float]:
+    """Spread (1st to 99th percentile) and white-noise level (from second differences)."""
+    lo, hi = np.percentile(a, [1.0, 99.0])
+    if a.size < 5:
+        return float(hi - lo), 0.0
+    d2 = np.diff(a, 2)
+    noise = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
+    return float(hi - lo), noise
+
+
+def excitation_problems(
+    delta: npt.ArrayLike, psi: npt.ArrayLike | None = None, r: npt.ArrayLike | None = None
+) -> list[str]:
+    """What is missing for a yaw model to be identifiable from a record (empty: nothing).
+
+    The rudder must move (spread above :data:`RUDDER_EXCITATION` and above 6 times its noise)
+    and the ship must turn (heading spread above :data:`HEADING_EXCITATION`, or without a
+    heading the yaw-rate spread above :data:`YAW_RATE_EXCITATION`, again above 6 times the
+    noise). Without either no fit can tell the gain from the time constant: it returns
+    meaningless numbers (T of 1e9 s, K of 1e-40 1/s).
+
+    Parameters
+    ----------
+    delta : array_like
+        Rudder [rad].
+    psi, r : array_like, optional
+        Heading [rad] and yaw rate [rad/s].
+
+    Returns
+    -------
+    list of str
+        One phrase per missing excitation, e.g. ``"the rudder never moves (...)"``.
+    """
+    out = []
+    checks = [("rudder never moves", "delta", delta, RUDDER_EXCITATION, "deg")]
+    if psi is not None:
+        checks.append(("heading never changes", "psi", psi, HEADING_EXCITATION, "deg"))
+    elif r is not None:
+        checks.append(("yaw rate never changes", "r", r, YAW_RATE_EXCITATION, "deg/s"))
+    for what, name, values, floor, unit in checks:
+        arr = np.asarray(values, dtype=np.float64)
+        if arr.size == 0:
+            continue
+        spread, noise = _spread_and_noise(arr)
+        if not spread > max(floor, 6.0 * noise):
+            out.append(
+                f"the {what} ({name} spans {math.degrees(spread):.3g} {unit} between its 1st and"
+                f" 99th percentiles; needs more than {math.degrees(floor):.3g} {unit}"
+                + (f" and 6 times its noise {math.degrees(noise):.3g} {unit}" if noise else "")
+                + ")"
+            )
+    return out
+
+
+def check_excitation(
+    delta: npt.ArrayLike, psi: npt.ArrayLike | None = None, r: npt.ArrayLike | None = None
+) -> None:
+    """Raise when a record cannot identify a yaw model (see :func:`excitation_problems`).
+
+    Raises
+    ------
+    ValueError
+        ``"not identifiable: no excitation: the rudder never moves (...)"`` naming every
+        missing excitation.
+    """
+    problems = excitation_problems(delta, psi, r)
+    if problems:
+        raise ValueError(
+            "not identifiable: no excitation: "
+            + " and ".join(problems)
+            + "; expected a manoeuvre that moves the rudder and turns the ship (zigzag, turning"
+            " circle, pull-out or random rudder)"
+        )
 
 
 def _check_model(model: str) -> str:
@@ -646,6 +746,9 @@ def fit_equation_error(
     ValueError
         For bad input or coefficients that do not map to a valid model.
     """
+    check_excitation(
+        _as_1d("delta", delta), None if psi is None else _as_1d("psi", psi), _as_1d("r", r)
+    )
     reg = regression_data(
         t, delta, r, model, bias=bias, window=window, polyorder=polyorder, trim=True
     )
@@ -924,6 +1027,7 @@ def fit_output_error(
     delta = _as_1d("delta", delta, n)
     psi = _as_1d("psi", psi, n)
     r = _as_1d("r", r, n)
+    check_excitation(delta, psi, r)
     speed = _speed(U, t)
     cls = _PARAM_CLASS[model]
     if init is not None and not isinstance(init, cls):
