@@ -1,0 +1,397 @@
+"""Hostile inputs to the identification loaders and fits: each is refused with a message naming
+what was wrong and what was expected, or accepted and reported (``shipgym.sysid.data``,
+``shipgym.sysid.fit``, ``shipgym.sysid.engine``)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import shipgym.sysid.data as data_module
+from shipgym.cli import main
+from shipgym.sysid import identify
+from shipgym.sysid.data import Record, SysidDataWarning, load
+from shipgym.sysid.fit import fit_equation_error, fit_output_error
+
+MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+needs_data = pytest.mark.skipif(
+    not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}"
+)
+
+
+def _zigzag(n: int = 801, dt: float = 0.5, seed: int = 0, K: float = 0.1) -> Record:
+    """A first-order Nomoto zigzag (K 1/s, T = 30 s, 20 deg) with a little noise."""
+    rng = np.random.default_rng(seed)
+    t = dt * np.arange(n)
+    T, amp = 30.0, math.radians(20.0)
+    delta = np.empty(n)
+    r = np.zeros(n)
+    psi = np.zeros(n)
+    side = 1.0
+    for k in range(n):
+        if k and side * psi[k - 1] > amp:
+            side = -side
+        delta[k] = side * amp
+        if k:
+            r[k] = r[k - 1] + dt * (K * delta[k - 1] - r[k - 1]) / T
+            psi[k] = psi[k - 1] + dt * 0.5 * (r[k] + r[k - 1])
+    U = np.full(n, 5.0)
+    x = np.cumsum(U * dt * np.cos(psi))
+    y = np.cumsum(U * dt * np.sin(psi))
+    return Record(
+        time=t,
+        delta=delta + 1e-4 * rng.standard_normal(n),
+        psi=psi + 1e-4 * rng.standard_normal(n),
+        r=r + 1e-5 * rng.standard_normal(n),
+        x=x,
+        y=y,
+        U=U,
+        meta={"source": "test", "repairs": [], "notes": []},
+    )
+
+
+def _run(argv: list[str]) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    return code, out.getvalue(), err.getvalue()
+
+
+def _load_quiet(path: Path, fmt: str | None = None) -> Record:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SysidDataWarning)
+        return load(path, fmt)
+
+
+# ---------------------------------------------------------------------------------------------
+# canonical meta validated on reading
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("line", "expected"),
+    [
+        ("# repairs: 5", r"meta 'repairs' is a number 5; expected a JSON list of strings"),
+        ('# repairs: "abc"', r"meta 'repairs' is a string \"abc\"; expected a JSON list of str"),
+        ("# notes: [1, 2]", r"meta 'notes' is a list \[1, 2\]; expected a JSON list of strings"),
+        ("# L: -3", r"meta 'L' is a number -3; expected the ship length in m"),
+        ("# irregular_sampling: 1", r"meta 'irregular_sampling' .*; expected true or false"),
+    ],
+)
+def test_canonical_meta_of_the_wrong_type_is_refused_naming_file_and_line(
+    tmp_path: Path, line: str, expected: str
+) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    key = line[2:].split(":")[0]
+    lines = [ln for ln in path.read_text().splitlines() if not ln.startswith(f"# {key}:")]
+    lines.insert(1, line)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"^rec\.csv line 2: " + expected):
+        load(path)
+
+
+def test_canonical_meta_repeated_key_refused(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    lines = path.read_text().splitlines()
+    lines.insert(1, '# source: "other"')
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"rec\.csv line \d+: meta key 'source' repeats line 2"):
+        load(path)
+
+
+def test_cli_bad_canonical_meta_exits_2_with_one_line(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    text = path.read_text().replace("# repairs: []", "# repairs: 5")
+    path.write_text(text)
+    code, stdout, stderr = _run(["identify", str(path), "--quiet"])
+    assert code == 2, stderr
+    assert "Traceback" not in stderr
+    errors = [ln for ln in stderr.splitlines() if "error:" in ln]
+    assert len(errors) == 1 and "meta 'repairs'" in errors[0] and "line" in errors[0], stderr
+    assert stdout == ""
+
+
+# ---------------------------------------------------------------------------------------------
+# unit checks on loading
+# ---------------------------------------------------------------------------------------------
+def _canonical_variant(tmp_path: Path, **channels: np.ndarray) -> Path:
+    rec = _zigzag()
+    return Record(**{**rec.channels(), **channels}, meta=rec.meta).to_csv(tmp_path / "rec.csv")
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (
+            {"psi": lambda rec: np.degrees(rec.psi) % 360.0},
+            r"column 'psi_rad' looks like degrees: it jumps from .* \(a heading wrapped at 360 "
+            r"deg\).*expected radians",
+        ),
+        (
+            {"psi": lambda rec: np.degrees(rec.psi)},
+            r"heading changes 5\d\.\d+ times the integral of the yaw rate.*'psi_rad' looks like "
+            r"degrees",
+        ),
+        (
+            {"r": lambda rec: np.degrees(rec.r)},
+            r"'r_rad_s' looks like deg/s",
+        ),
+        (
+            {"time": lambda rec: 1000.0 * rec.time},
+            r"column 'time_s' looks like milliseconds; expected seconds",
+        ),
+        (
+            {"delta": lambda rec: np.degrees(rec.delta)},
+            r"column 'delta_rad' reaches 20\.\d+ rad .* looks like degrees; expected radians",
+        ),
+        (
+            {"U": lambda rec: rec.U / 0.514444},
+            r"column 'U_m_s' looks like knots; expected m/s",
+        ),
+    ],
+    ids=["psi-deg-wrapped", "psi-deg", "r-deg-s", "time-ms", "delta-deg", "U-knots"],
+)
+def test_canonical_unit_errors_refused_naming_the_probable_unit(
+    tmp_path: Path, change: dict, expected: str
+) -> None:
+    rec = _zigzag()
+    path = _canonical_variant(tmp_path, **{k: f(rec) for k, f in change.items()})
+    with pytest.raises(ValueError, match=r"^rec\.csv: .*" + expected):
+        _load_quiet(path)
+
+
+def _sspa_file(
+    tmp_path: Path, time: np.ndarray, psi: np.ndarray, r: np.ndarray, K: float = 0.1
+) -> Path:
+    rec = _zigzag(K=K)
+    rows = np.column_stack([time, -rec.delta, rec.x, rec.y, psi, r])
+    path = tmp_path / "sspa.csv"
+    body = "\n".join(";".join(repr(float(v)) for v in row) for row in rows)
+    path.write_text("time;delta;x0;y0;psi;r\n" + body + "\n")
+    return path
+
+
+def test_sspa_heading_in_degrees_refused(tmp_path: Path) -> None:
+    rec = _zigzag(K=0.5)  # a model-scale ship: up to 10 deg/s
+    psi = (np.degrees(rec.psi) + 5.0) % 360.0  # wraps 359 -> 0 as a compass does
+    path = _sspa_file(tmp_path, rec.time, psi, np.gradient(psi, rec.time), K=0.5)
+    with pytest.raises(
+        ValueError, match=r"column 'psi' looks like degrees: it jumps from [\d.]+ to 3\d\d\."
+    ):
+        _load_quiet(path, "sspa")
+    psi = np.degrees(rec.psi)  # no wrap: psi and r (its derivative) both in degrees
+    path = _sspa_file(tmp_path, rec.time, psi, np.gradient(psi, rec.time), K=0.5)
+    with pytest.raises(ValueError, match=r"'r' reaches .* deg/s, and column 'psi'.* like degrees"):
+        _load_quiet(path, "sspa")
+
+
+def test_sspa_time_in_milliseconds_refused_or_warned(tmp_path: Path) -> None:
+    rec = _zigzag()
+    # r in rad/s but time in ms: the heading changes 1000 times too slowly -> refused
+    path = _sspa_file(tmp_path, 1000.0 * rec.time, rec.psi, rec.r)
+    with pytest.raises(ValueError, match=r"column 'time' looks like milliseconds"):
+        _load_quiet(path, "sspa")
+    # r consistent with a time in ms (rad/ms): only the sample interval tells -> warned
+    path = _sspa_file(tmp_path, 1000.0 * rec.time, rec.psi, rec.r / 1000.0)
+    with pytest.warns(SysidDataWarning, match=r"median sample interval is 500 s .* milliseconds"):
+        loaded = load(path, "sspa")
+    assert any("unit check" in note for note in loaded.meta["notes"])
+
+
+def test_consistent_units_load_without_unit_warnings(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SysidDataWarning)
+        rec = load(path)
+    assert not any("unit check" in note for note in rec.meta["notes"])
+
+
+@needs_data
+def test_measured_sources_pass_the_unit_checks() -> None:
+    files = sorted(p for p in MEASURED.rglob("*") if p.suffix in (".csv", ".dat"))
+    assert files
+    for path in files:
+        rec = _load_quiet(path)
+        assert not any("unit check" in note for note in rec.meta["notes"]), path.name
+
+
+# ---------------------------------------------------------------------------------------------
+# no excitation: not identifiable
+# ---------------------------------------------------------------------------------------------
+def _without(what: str) -> Record:
+    rec = _zigzag()
+    rng = np.random.default_rng(3)
+    n = rec.n
+    chans = rec.channels()
+    if what == "rudder":
+        chans["delta"] = 1e-3 * rng.standard_normal(n)  # noise only
+    elif what == "heading":
+        chans["psi"] = 0.3 + 1e-3 * rng.standard_normal(n)
+        chans["r"] = 1e-4 * rng.standard_normal(n)
+    else:  # all zero
+        chans = {"time": rec.time, "delta": np.zeros(n), "psi": np.zeros(n), "r": np.zeros(n)}
+    return Record(**chans)
+
+
+NO_RUDDER = r"not identifiable: no excitation: the rudder never moves \(delta spans"
+NO_HEADING = r"not identifiable: no excitation: .*the heading never changes \(psi spans"
+
+
+@pytest.mark.parametrize(
+    ("what", "expected"),
+    [
+        ("rudder", NO_RUDDER),
+        ("heading", NO_HEADING),
+        ("all", NO_RUDDER + r".* and the heading never changes"),
+    ],
+)
+def test_fits_refuse_records_without_excitation(what: str, expected: str) -> None:
+    rec = _without(what)
+    with pytest.raises(ValueError, match=expected):
+        fit_output_error(rec.time, rec.delta, rec.psi, rec.r, "nomoto1")
+    with pytest.raises(ValueError, match=expected):
+        fit_equation_error(rec.time, rec.delta, rec.r, "nomoto1", psi=rec.psi)
+    with pytest.raises(ValueError, match=expected):
+        identify(rec, "nomoto1", max_effects=0)
+
+
+def test_every_family_refuses_a_record_without_excitation() -> None:
+    rec = _without("all")
+    for model in ("nomoto2", "rvg3dof"):
+        with pytest.raises(ValueError, match=NO_RUDDER):
+            identify(rec, model, max_effects=0)
+
+
+def test_cli_record_without_excitation_exits_2(tmp_path: Path) -> None:
+    path = _without("rudder").to_csv(tmp_path / "flat.csv")
+    code, stdout, stderr = _run(["identify", str(path), "--quiet", "--max-effects", "0"])
+    assert code == 2, stderr
+    errors = [ln for ln in stderr.splitlines() if "error:" in ln]
+    assert len(errors) == 1 and "the rudder never moves" in errors[0], stderr
+    assert stdout == ""
+
+
+def test_excited_record_still_fits() -> None:
+    rec = _zigzag()
+    fit = fit_output_error(rec.time, rec.delta, rec.psi, rec.r, "nomoto1")
+    assert fit.values["K"] == pytest.approx(0.1, rel=0.05)
+    assert fit.values["T"] == pytest.approx(30.0, rel=0.05)
+
+
+# ---------------------------------------------------------------------------------------------
+# header: duplicated column names, byte-order mark
+# ---------------------------------------------------------------------------------------------
+def test_duplicated_canonical_column_refused(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    text = path.read_text().replace(",U_m_s\n", ",psi_rad\n", 1)
+    path.write_text(text)
+    with pytest.raises(
+        ValueError, match=r"column 'psi_rad' appears 2 times in the header \(columns 3, 7\)"
+    ):
+        load(path)
+
+
+def test_duplicated_column_refused_in_named_header_formats(tmp_path: Path) -> None:
+    path = tmp_path / "usv.csv"
+    path.write_text("time,lon,lat,speed,heading,rudder,heading\n0,1,2,3,4,5,6\n1,1,2,3,4,5,6\n")
+    with pytest.raises(ValueError, match=r"column 'heading' appears 2 times"):
+        load(path, "usv")
+
+
+def test_utf8_bom_before_canonical_header_accepted(tmp_path: Path) -> None:
+    plain = _zigzag().to_csv(tmp_path / "plain.csv")
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    a, b = load(plain), load(bom)  # detected as canonical despite the BOM
+    for name, value in a.channels().items():
+        np.testing.assert_array_equal(getattr(b, name), value)
+    assert b.meta == a.meta
+
+
+@needs_data
+@pytest.mark.parametrize(
+    "rel",
+    [
+        "sspa_blog_zigzag/example_zigzag.csv",
+        "marin_kvlcc2/MARIN_FREE_KVLCC2_zz_10_m.dat",
+        "hsva_kvlcc2/HSVA_CPMC_KVLCC2_Z_10_10_S.dat",
+        "esso_osaka_frt/zigzag/zigzag_31-Jul-2020_13_04_24.csv",
+        "usv_field/zigzag_30_inter_xy.csv",
+        "gunnerus_seatrials/RVG_ManeuveringTests.csv",
+    ],
+)
+def test_utf8_bom_accepted_for_every_source_format(tmp_path: Path, rel: str) -> None:
+    src = MEASURED / rel
+    copy = tmp_path / src.parent.name / src.name  # keeps the folder name used for detection
+    copy.parent.mkdir()
+    copy.write_bytes(b"\xef\xbb\xbf" + src.read_bytes())
+    a, b = _load_quiet(src), _load_quiet(copy)
+    for name, value in a.channels().items():
+        np.testing.assert_array_equal(getattr(b, name), value)
+
+
+# ---------------------------------------------------------------------------------------------
+# large records
+# ---------------------------------------------------------------------------------------------
+def test_large_record_warns_and_shows_progress(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = _zigzag(n=3000).to_csv(tmp_path / "rec.csv")
+    monkeypatch.setattr(data_module, "LARGE_RECORD_SAMPLES", 2000)
+    monkeypatch.setattr(data_module, "PROGRESS_FILE_BYTES", 1000)
+    monkeypatch.setattr(data_module, "_PARSE_CHUNK", 1000)
+    err = io.StringIO()
+    with (
+        contextlib.redirect_stderr(err),
+        pytest.warns(SysidDataWarning, match=r"rec\.csv: large record of 3,000 samples"),
+    ):
+        rec = load(path)  # default progress: stderr, as the file is above the size
+    assert rec.n == 3000
+    lines = err.getvalue().splitlines()
+    assert lines[0].startswith("loading rec.csv (")
+    assert any("parsed 2,000 of 3,000 rows" in ln for ln in lines), lines
+    assert lines[-1].startswith("loaded rec.csv: 3,000 samples")
+    seen: list[str] = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SysidDataWarning)
+        load(path, progress=seen.append)
+    assert len(seen) == len(lines)
+
+
+def test_small_record_is_silent(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), warnings.catch_warnings():
+        warnings.simplefilter("error", SysidDataWarning)
+        load(path)
+    assert err.getvalue() == ""
+
+
+def test_canonical_parse_has_no_per_row_python_loop(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A clean file is parsed by numpy in chunks (the row-by-row parser was about 7 times slower
+    for 2 million rows); the row-by-row parser is only the fallback that names a bad line."""
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+
+    def refuse(*args: object) -> None:
+        raise AssertionError("clean rows went through the row-by-row parser")
+
+    monkeypatch.setattr(data_module, "_parse_rows_slow", refuse)
+    rec = _load_quiet(path)
+    np.testing.assert_array_equal(rec.psi, _zigzag().psi)
+
+
+def test_partial_rows_still_named_after_the_fast_parse(tmp_path: Path) -> None:
+    path = _zigzag().to_csv(tmp_path / "rec.csv")
+    lines = path.read_text().splitlines()
+    header = next(i for i, ln in enumerate(lines) if ln.startswith("time_s"))
+    fields = lines[header + 10].split(",")
+    lines[header + 10] = ",".join(fields[:-1])
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=rf"rec\.csv line {header + 11}: expected 7 fields, got 6"):
+        load(path)
