@@ -93,12 +93,12 @@ yaw rate vs heading derivative       the heading change over ~200 blocks against
 yaw-rate magnitude                   refused above 2 rad/s (99.9th percentile of abs(r):
                                      deg/s, named with psi when psi agrees), warned above 1 rad/s
 rudder magnitude                     refused above pi rad (degrees), warned above pi/2
-sample time vs speed                 distance run by x, y over blocks of at most 5 s against the
-                                     integral of a measured U: refused within a factor 1.2 of
-                                     1e-3 (time in ms or x, y in km), 0.514 (U in knots), 1/3.6
-                                     (U in km/h), warned outside [0.5, 2]; a median sample
-                                     interval above 10 s is warned about (time in ms?), with
-                                     the median speed
+sample time vs speed                 (canonical files) distance run by x, y over blocks of at
+                                     most 5 s against the integral of U: refused within a
+                                     factor 1.2 of 1e-3 (time in ms or x, y in km), 0.514 (U in
+                                     knots), 1/3.6 (U in km/h), warned outside [0.5, 2]; a
+                                     median sample interval above 10 s is warned about (time in
+                                     ms?), with the median speed
 ==================================== ===========================================================
 
 A heading and a yaw rate that are both in degrees (so agree with each other) of a slowly turning
@@ -1403,10 +1403,7 @@ def _load_usv(path: Path, say: Callable[[str], None] = _silent) -> Record:
         None,
         delta,
         meta,
-        names={"psi": "heading", "delta": "rudder", "U": "speed"},
-        U=speed,
-        x=x,
-        y=y,
+        names={"psi": "heading", "delta": "rudder"},
     )
     psi = _repair_heading(t, data[:, ix["heading"]] * deg, None, meta)
     _flag_irregular(t, meta)
@@ -1460,10 +1457,7 @@ def _load_gunnerus(path: Path, say: Callable[[str], None] = _silent) -> Record:
         r,
         -azimuth,
         meta,
-        names={"time": "tvec", "delta": "Azi", "U": "u, v"},
-        U=np.hypot(u, v),
-        x=data[:, ix["N"]],
-        y=data[:, ix["E"]],
+        names={"time": "tvec", "delta": "Azi"},
     )
     psi = _repair_heading(t, data[:, ix["psi"]] * deg, r, meta)
     _warn(

@@ -746,11 +746,11 @@ def fit_equation_error(
     ValueError
         For bad input or coefficients that do not map to a valid model.
     """
+    reg = regression_data(  # checks the model, time, lengths, values and window first
+        t, delta, r, model, bias=bias, window=window, polyorder=polyorder, trim=True
+    )
     check_excitation(
         _as_1d("delta", delta), None if psi is None else _as_1d("psi", psi), _as_1d("r", r)
-    )
-    reg = regression_data(
-        t, delta, r, model, bias=bias, window=window, polyorder=polyorder, trim=True
     )
     X, y = reg.X, reg.y
     n, m = X.shape
