@@ -1,6 +1,13 @@
 """Pure vessel dynamics: parameters, batched state derivatives, actuators, current, RK4.
 
 Every model is one Numba kernel shared by all users; see :mod:`shipgym.models.integrate`.
+
+The Python API (:func:`make_model`, the :class:`ShipModel` methods, ``integrate.rhs`` and
+``integrate.rk4_step``, ``vmm.term_monomials``, :func:`current_ned`, :func:`ssa`) checks its
+arguments before any kernel sees them and raises ``TypeError`` or ``ValueError`` naming what was
+wrong and what was expected; it never returns NaN from finite input. The compiled per-ship
+kernels (``*_row``, ``rk4_stages``, ``rk4_row``, the kinematics helpers) are for compiled code
+and take their arguments unchecked.
 """
 
 from shipgym.models.angles import ssa

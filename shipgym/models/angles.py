@@ -7,6 +7,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from shipgym.models._checks import real_array
 from shipgym.models._jit import kernel
 
 TWO_PI = 2.0 * math.pi
@@ -14,7 +15,8 @@ TWO_PI = 2.0 * math.pi
 
 @kernel
 def ssa_scalar(angle: float) -> float:
-    """Smallest signed angle: wrap ``angle`` [rad] to [-pi, pi)."""
+    """Smallest signed angle: wrap ``angle`` [rad] to [-pi, pi) (compiled, for kernels; from
+    Python use :func:`ssa`, which checks its argument)."""
     return (angle + math.pi) % TWO_PI - math.pi
 
 
@@ -29,7 +31,17 @@ def ssa(angle: npt.ArrayLike) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        The wrapped angles, same shape as ``angle``.
+        The wrapped angles, same shape as ``angle``. A NaN stays NaN (a missing angle stays
+        missing).
+
+    Raises
+    ------
+    TypeError
+        When ``angle`` is not real numbers.
+    ValueError
+        For an infinite angle (it has no direction: wrapping it would give NaN).
     """
-    a = np.asarray(angle, dtype=np.float64)
+    a = real_array(angle, "angle")
+    if np.isinf(a).any():
+        raise ValueError(f"angle must not be infinite (rad), got {a[np.isinf(a)][0]!r}")
     return np.mod(a + np.pi, TWO_PI) - np.pi

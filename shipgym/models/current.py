@@ -10,9 +10,12 @@ components ``(V_c cos beta_c, V_c sin beta_c)`` [m/s] per ship in the batch.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
+
+from shipgym.models._checks import real_array
 
 
 @dataclass(frozen=True)
@@ -45,11 +48,46 @@ class Current:
 
     def as_batch(self, n: int = 1) -> np.ndarray:
         """The current as the ``(n, 2)`` north/east array that model kernels take."""
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
+            raise ValueError(f"Current.as_batch: n must be an integer >= 0, got {n!r}")
         return np.tile(np.array(self.ned, dtype=np.float64), (n, 1))
 
 
 def current_ned(speed: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """Batch of currents as ``(n, 2)`` north/east components [m/s] from speed and direction."""
-    speed = np.asarray(speed, dtype=np.float64)
-    direction = np.asarray(direction, dtype=np.float64)
+    """Batch of currents as ``(n, 2)`` north/east components [m/s] from speed and direction.
+
+    Parameters
+    ----------
+    speed : array_like
+        Current speeds ``V_c`` [m/s], finite and >= 0.
+    direction : array_like
+        Directions the water moves toward, ``beta_c`` [rad], finite; broadcast with ``speed``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``broadcast(speed, direction).shape + (2,)``.
+
+    Raises
+    ------
+    TypeError
+        When either is not real numbers.
+    ValueError
+        When the shapes do not broadcast, a speed is negative or a value is not finite.
+    """
+    speed = real_array(speed, "current speed")
+    direction = real_array(direction, "current direction")
+    try:
+        speed, direction = np.broadcast_arrays(speed, direction)
+    except ValueError:
+        raise ValueError(
+            f"current speed and direction must broadcast to one shape, got {speed.shape} and "
+            f"{direction.shape}"
+        ) from None
+    if not (np.isfinite(speed).all() and (speed >= 0.0).all()):
+        bad = speed[~(np.isfinite(speed) & (speed >= 0.0))][0]
+        raise ValueError(f"current speed must be finite and >= 0 m/s, got {bad!r}")
+    if not np.isfinite(direction).all():
+        bad = direction[~np.isfinite(direction)][0]
+        raise ValueError(f"current direction must be finite (rad), got {bad!r}")
     return np.stack((speed * np.cos(direction), speed * np.sin(direction)), axis=-1)

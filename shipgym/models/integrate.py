@@ -12,12 +12,35 @@ stay in the CPU cache; the environments' kernels call ``rk4_row`` (the same stag
 environment models' derivative ``row_rhs``) inside their own row loops, so they do not compile
 the 3-DOF model-test models (MMG, VMM), which no environment uses (it would add 40 % to their
 compile time).
+
+Checked and unchecked entry points
+----------------------------------
+Numba does no bounds checking. ``rhs`` and ``rk4_step`` are the Python entry points: they check
+the model id, the rows and columns of every array against the model, the parameter vector's
+length and that everything is finite, then call the compiled ``rhs_kernel`` and
+``rk4_step_kernel``. Those, and the per-ship ``row_rhs``, ``rk4_stages`` and ``rk4_row``, take
+their arguments as they are: they are for compiled callers and for code that has already
+checked the arrays (:class:`shipgym.models.ShipModel`).
+
+Stability of the fixed step
+---------------------------
+RK4 applied to ``x' = lambda x`` multiplies ``x`` by ``R(h lambda)`` per step,
+``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24``. A decaying mode is reproduced only while
+``|R(h lambda)| <= 1``: on the negative real axis up to ``h |lambda| = 2.785``, on the imaginary
+axis up to ``2 sqrt(2)``. Beyond that the step does not give a rough answer but a wrong one that
+grows exponentially. :func:`rk4_stable_step` is the largest step that keeps every decaying
+eigenvalue of a linearisation inside that region.
 """
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import numpy as np
 
+from shipgym.models import mmg, nomoto, rvg, vmm
+from shipgym.models._checks import real_array, require_finite, shape_error, step_size
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.mmg import mmg_row
 from shipgym.models.nomoto import bech_row, nomoto1_row, nomoto2_row, norrbin_row
@@ -25,6 +48,27 @@ from shipgym.models.rvg import rvg_row
 from shipgym.models.vmm import vmm_row
 
 NOMOTO1, NOMOTO2, NORRBIN, BECH, RVG3DOF, KVLCC2, VMM = 0, 1, 2, 3, 4, 5, 6
+MODEL_IDS = {"nomoto1": 0, "nomoto2": 1, "norrbin": 2, "bech": 3, "rvg3dof": 4, "kvlcc2": 5,
+             "vmm": 6}  # fmt: skip
+"""Model id of each model name (the ``model_id`` argument of the kernels)."""
+_NAMES = tuple(MODEL_IDS)
+#: states and inputs of each model id
+STATE_COUNTS = (
+    len(nomoto.FIRST_ORDER_STATES), len(nomoto.SECOND_ORDER_STATES),
+    len(nomoto.FIRST_ORDER_STATES), len(nomoto.SECOND_ORDER_STATES),
+    len(rvg.RVG_STATES), len(mmg.MMG_STATES), len(vmm.VMM_STATES),
+)  # fmt: skip
+INPUT_COUNTS = (
+    *(len(nomoto.NOMOTO_INPUTS),) * 4, len(rvg.RVG_INPUTS), len(mmg.MMG_INPUTS),
+    len(vmm.VMM_INPUTS),
+)  # fmt: skip
+#: packed parameters of each model id (the VMM's length depends on its terms: -1)
+_PARAMETER_COUNTS = (
+    *(nomoto.P_YAW + len(cls().coefficients()) for cls in (
+        nomoto.Nomoto1Params, nomoto.Nomoto2Params, nomoto.NorrbinParams, nomoto.BechParams
+    )),
+    rvg.P_SIZE, mmg.P_SIZE, -1,
+)  # fmt: skip
 
 
 @row_kernel
@@ -56,8 +100,9 @@ def row_rhs_all(model_id, x, u, p, c, out):
 
 
 @kernel
-def rhs(model_id, x, u, p, c, out):
-    """Batched state derivative of model ``model_id``, written into ``out``."""
+def rhs_kernel(model_id, x, u, p, c, out):
+    """Batched state derivative of model ``model_id``, written into ``out`` (unchecked: see
+    :func:`rhs`)."""
     for i in range(x.shape[0]):
         row_rhs_all(model_id, x[i], u[i], p, c[i], out[i])
 
@@ -100,9 +145,166 @@ PARALLEL_MIN_ROWS = 64
 
 
 @kernel
-def rk4_step(model_id, x, u, p, c, h):
-    """Advance every row of ``x`` in place by one RK4 step of length ``h`` [s]."""
+def rk4_step_kernel(model_id, x, u, p, c, h):
+    """Advance every row of ``x`` in place by one RK4 step of length ``h`` [s] (unchecked: see
+    :func:`rk4_step`)."""
     work = np.empty((5, x.shape[1]))
     k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
     for i in range(x.shape[0]):
         rk4_stages(row_rhs_all, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
+
+
+def check_parameters(model_id: int, p: np.ndarray) -> None:
+    """``ValueError`` unless ``p`` is a finite parameter vector of the length model ``model_id``
+    reads (the output of the model's ``pack_*`` function)."""
+    name = _NAMES[model_id]
+    if p.ndim != 1:
+        raise shape_error(f"p of model {name!r}", "(n_parameters,)", p.shape)
+    if model_id == VMM:
+        vmm.check_packed(p)
+    elif p.size != _PARAMETER_COUNTS[model_id]:
+        raise ValueError(
+            f"p of model {name!r} must have {_PARAMETER_COUNTS[model_id]} entries (its pack_* "
+            f"function's output), got {p.size}"
+        )
+    require_finite(p, f"p of model {name!r}")
+
+
+def _kernel_args(
+    model_id: Any, x: Any, u: Any, p: Any, c: Any
+) -> tuple[int, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The checked arguments of :func:`rhs` and :func:`rk4_step` (``x`` must already be a
+    writable float64 array: both write into arrays the caller owns)."""
+    if (
+        isinstance(model_id, bool)
+        or not isinstance(model_id, int | np.integer)
+        or not (0 <= model_id < len(_NAMES))
+    ):
+        raise ValueError(f"model_id must be one of {dict(enumerate(_NAMES))}, got {model_id!r}")
+    model_id = int(model_id)
+    nx, nu = STATE_COUNTS[model_id], INPUT_COUNTS[model_id]
+    if not (
+        type(x) is np.ndarray and x.dtype == np.float64 and x.flags.writeable
+        and x.flags.c_contiguous
+    ):  # fmt: skip
+        raise TypeError(
+            "x must be a writable float64 array in C order (the kernels write into it), got "
+            f"{type(x).__name__}" + (f" of dtype {x.dtype}" if isinstance(x, np.ndarray) else "")
+        )
+    if x.ndim != 2 or x.shape[1] != nx:
+        raise shape_error("x", f"(n, {nx})", x.shape, f" for model {_NAMES[model_id]!r}")
+    n = x.shape[0]
+    u = np.ascontiguousarray(real_array(u, "u"))
+    if u.shape != (n, nu):
+        raise shape_error("u", f"({n}, {nu})", u.shape, " (one input row per state row)")
+    c = np.ascontiguousarray(real_array(c, "c"))
+    if c.shape != (n, 2):
+        raise shape_error("c", f"({n}, 2)", c.shape, " (north/east current per state row)")
+    p = real_array(p, "p")
+    check_parameters(model_id, p)
+    if p.flags.writeable:  # the kernels are compiled for a read-only parameter vector
+        p = p.view()
+        p.flags.writeable = False
+    for arr, name in ((x, "x"), (u, "u"), (c, "c")):
+        require_finite(arr, name)
+    return model_id, x, u, p, c
+
+
+def rhs(model_id: int, x: np.ndarray, u: Any, p: Any, c: Any, out: np.ndarray) -> None:
+    """Batched state derivative ``out = f(x, u, p, c)`` of model ``model_id``, checked.
+
+    Parameters
+    ----------
+    model_id : int
+        :data:`MODEL_IDS` value of the model.
+    x : numpy.ndarray
+        States, float64 ``(n, nx)``.
+    u : array_like
+        Inputs ``(n, nu)``.
+    p : array_like
+        The model's packed parameters (``pack_nomoto``, ``pack_rvg``, ``pack_mmg``,
+        ``pack_vmm``).
+    c : array_like
+        North/east current [m/s], ``(n, 2)``.
+    out : numpy.ndarray
+        Writable float64 ``(n, nx)`` array that receives ``x'``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the argument whose type, shape or values do not fit the model.
+    """
+    model_id, x, u, p, c = _kernel_args(model_id, np.ascontiguousarray(real_array(x, "x")),
+                                        u, p, c)  # fmt: skip
+    if not (
+        type(out) is np.ndarray and out.dtype == np.float64 and out.flags.writeable
+        and out.flags.c_contiguous and out.shape == x.shape
+    ):  # fmt: skip
+        got = out.shape if isinstance(out, np.ndarray) else type(out).__name__
+        raise ValueError(
+            f"out must have shape {x.shape} (writable float64, C order) like x, got {got}"
+        )
+    rhs_kernel(model_id, x, u, p, c, out)
+
+
+def rk4_step(model_id: int, x: np.ndarray, u: Any, p: Any, c: Any, h: float) -> None:
+    """Advance every row of ``x`` in place by one RK4 step of ``h`` [s], checked.
+
+    The arguments are those of :func:`rhs` (``x`` a writable float64 ``(n, nx)`` array in C
+    order, updated in place); ``h`` is a finite step > 0 s. The step is not checked against
+    :func:`rk4_stable_step` here (:meth:`shipgym.models.ShipModel.step` does that).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the argument whose type, shape or values do not fit the model.
+    """
+    h = step_size(h)
+    model_id, x, u, p, c = _kernel_args(model_id, x, u, p, c)
+    rk4_step_kernel(model_id, x, u, p, c, h)
+
+
+def rk4_amplification(z: np.ndarray) -> np.ndarray:
+    """RK4's growth per step, ``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24`` at ``z = h lambda``."""
+    return 1.0 + z * (1.0 + z * (0.5 + z * (1.0 / 6.0 + z / 24.0)))
+
+
+_RAY = np.linspace(0.0, 3.0, 301)[1:]  # the RK4 region lies inside |z| < 2.97
+
+
+def rk4_stable_step(eigenvalues: Any) -> float:
+    """Largest step [s] for which RK4 keeps every decaying mode ``eigenvalues`` [1/s] decaying.
+
+    For each eigenvalue ``lambda`` with ``Re(lambda) <= 0`` (growing modes grow in the physics
+    too, zero ones are integrators such as position and heading) the largest ``h`` with
+    ``|R(s lambda)| <= 1`` for all ``s <= h`` (module docstring); the minimum over the
+    eigenvalues, ``inf`` when no eigenvalue limits the step. Purely real: ``2.785 / |lambda|``.
+
+    Raises
+    ------
+    ValueError
+        For a NaN or infinite eigenvalue.
+    """
+    lam = np.asarray(eigenvalues, dtype=np.complex128).ravel()
+    if not np.isfinite(lam).all():
+        raise ValueError(f"eigenvalues must be finite, got {lam[~np.isfinite(lam)][0]!r}")
+    mag = np.abs(lam)
+    if mag.size == 0 or mag.max() == 0.0:
+        return math.inf
+    keep = (mag > 1e-9 * mag.max()) & (lam.real <= 1e-9 * mag)
+    if not keep.any():
+        return math.inf
+    d = lam[keep] / mag[keep]
+    tol = 1.0 + 1e-9
+    bad = np.abs(rk4_amplification(_RAY[None, :] * d[:, None])) > tol
+    has = bad.any(axis=1)
+    first = bad.argmax(axis=1)
+    hi = _RAY[first]
+    lo = np.where(first > 0, _RAY[np.maximum(first - 1, 0)], 0.0)
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        out = np.abs(rk4_amplification(mid * d)) > tol
+        hi = np.where(out, mid, hi)
+        lo = np.where(out, lo, mid)
+    limits = np.where(has, lo, np.inf) / mag[keep]
+    return float(limits.min())

@@ -5,6 +5,10 @@ Shared by the 3-DOF models (:mod:`shipgym.models.rvg`, :mod:`shipgym.models.mmg`
 (seed 001 eq. 6) and the body-frame current ``nu_c = R_z(psi)^T [V_n, V_e, 0]`` (eq. 8) of the
 constant, irrotational current of :mod:`shipgym.models.current`; and the steering gear of the
 model-test ships (a first-order rudder inside angle and rate limits, seed 002 eq. 2).
+
+These are compiled per-ship building blocks that the model kernels inline; they take their
+arguments unchecked (Numba does no bounds checking), so they are for compiled code. From Python
+use :class:`shipgym.models.ShipModel`, whose methods check shapes and values first.
 """
 
 from __future__ import annotations

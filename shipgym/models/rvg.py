@@ -69,6 +69,10 @@ rad, rad]; input ``[T_1c, T_2c, alpha_1c, alpha_2c]``. Pod 1 is port (y < 0), po
 With zero thrust the relative-velocity dynamics are ``M nu_r' + (C_rb + C_a)(nu_r) nu_r +
 D nu_r = 0`` for an irrotational current (Fossen 2011 property 8.1 holds for eq. 14), so with a
 symmetric ``M`` the kinetic energy relative to the water, ``nu_r^T M nu_r / 2``, never grows.
+
+The compiled per-ship functions here (:func:`rvg_row`, :func:`pod_thrust`, :func:`pod_thrusts`,
+:func:`pod_axial_inflow`) take their arrays unchecked: ``p`` must be :func:`pack_rvg`'s output
+and ``x`` a full state. From Python, :class:`shipgym.models.ShipModel` checks its arguments.
 """
 
 from __future__ import annotations

@@ -55,6 +55,10 @@ relative to the water as in :mod:`shipgym.models.mmg`. Steering gear as in the M
 
 State ``[x, y, psi, u, v, r, delta]`` [m, m, rad, m/s, m/s, rad/s, rad]; input
 ``[delta_c, thrust, wind_speed, wind_angle]`` [rad, N, m/s, rad] (the apparent wind).
+
+The compiled per-ship functions (:func:`vmm_row`, :func:`vmm_forces`, :func:`prime_factors`,
+:func:`monomial`) take their arrays unchecked (they run inside other kernels); from Python use
+:class:`shipgym.models.ShipModel` or :func:`term_monomials`, which check their arguments.
 """
 
 from __future__ import annotations
@@ -70,6 +74,7 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.models._checks import positive_number, real_array, require_finite, shape_error
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.kinematics import relative_motion, steering_gear
 
@@ -80,11 +85,13 @@ __all__ = [
     "VMM_INPUTS",
     "VMM_STATES",
     "VMMParams",
+    "check_packed",
     "clarke_added_masses",
     "pack_vmm",
     "parse_term",
     "propeller_loading",
     "term_matrix",
+    "term_monomials",
     "vmm_row",
 ]
 
@@ -166,9 +173,22 @@ def term_matrix(names: Sequence[str]) -> np.ndarray:
 
 
 def propeller_loading(rps: np.ndarray, diameter: float, rho: float) -> np.ndarray:
-    """``rho D^4 n |n|`` [N]: the thrust input of a record with propeller revolutions only."""
-    n = np.asarray(rps, dtype=np.float64)
-    return rho * diameter**4 * n * np.abs(n)
+    """``rho D^4 n |n|`` [N]: the thrust input of a record with propeller revolutions only.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For revolutions that are not finite real numbers, or a diameter or density that is not
+        a finite number > 0.
+    """
+    n = real_array(rps, "rps")
+    require_finite(n, "rps")
+    diameter = positive_number(diameter, "diameter")
+    rho = positive_number(rho, "rho")
+    with np.errstate(over="ignore"):
+        loading = rho * diameter**4 * n * np.abs(n)
+    require_finite(loading, "propeller loading rho D^4 n |n| (too large)")
+    return loading
 
 
 def clarke_added_masses(
@@ -453,11 +473,73 @@ def vmm_forces(u_r, v_r, r, delta, thrust, wind_speed, wind_angle, p):
     return p[P_QX] * u2 * sx, p[P_QX] * u2 * sy, p[P_QN] * u2 * sn
 
 
-@kernel
-def term_monomials(x, inputs, p, c, out, u2):  # pragma: no cover - jit
+def check_packed(p: np.ndarray) -> None:
+    """``ValueError`` unless ``p`` has the layout :func:`pack_vmm` writes: the header, then
+    ``p[P_NTERMS]`` rows of coefficient, equation (0, 1, 2) and small whole exponents."""
+    n = p[P_NTERMS] if p.ndim == 1 and p.size > P_NTERMS else -1.0
+    ok = math.isfinite(n) and n >= 0 and n == int(n) and p.size == P_TERMS + TERM_WIDTH * int(n)
+    if ok:
+        table = p[P_TERMS:].reshape(int(n), TERM_WIDTH)
+        exps = table[:, 2:]
+        ok = bool(
+            np.isin(table[:, 1], (0.0, 1.0, 2.0)).all()
+            and ((exps >= 0) & (exps <= 16) & (exps == np.round(exps))).all()
+        )
+    if not ok:
+        raise ValueError(
+            f"p of model 'vmm' must be the output of pack_vmm ({P_TERMS} header entries, then "
+            f"{TERM_WIDTH} per term); got {p.size} entries that do not have that layout"
+        )
+
+
+def term_monomials(
+    x: np.ndarray, inputs: np.ndarray, p: np.ndarray, c: np.ndarray, out: np.ndarray,
+    u2: np.ndarray,
+) -> None:  # fmt: skip
     """Regressors of the identification: the monomial of every packed term at every row of
     states ``x`` ``(n, >= 6)`` and inputs ``(n, 4)`` into ``out`` ``(n, n_terms)``, and
-    ``U^2`` into ``u2`` (the same prime system as :func:`vmm_forces`)."""
+    ``U^2`` into ``u2`` ``(n,)`` (the same prime system as :func:`vmm_forces`); ``c`` is the
+    north/east current ``(2,)`` [m/s] and ``p`` the output of :func:`pack_vmm`.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the argument whose type, shape or values do not fit.
+    """
+    x = np.ascontiguousarray(real_array(x, "x"))
+    if x.ndim != 2 or x.shape[1] < 6:
+        raise shape_error("x", "(n, >= 6)", x.shape, " (states x, y, psi, u, v, r, ...)")
+    n = x.shape[0]
+    inputs = np.ascontiguousarray(real_array(inputs, "inputs"))
+    if inputs.shape != (n, 4):
+        raise shape_error("inputs", f"({n}, 4)", inputs.shape, f" {VMM_INPUTS} per row of x")
+    c = np.ascontiguousarray(real_array(c, "current"))
+    if c.shape != (2,):
+        raise shape_error("current", "(2,)", c.shape, " (north/east [m/s])")
+    p = np.ascontiguousarray(real_array(p, "p"))
+    check_packed(p)
+    require_finite(p, "p of model 'vmm'")
+    for arr, name in ((x, "x"), (inputs, "inputs"), (c, "current")):
+        require_finite(arr, name)
+    for arr, name, shape in ((out, "out", (n, int(p[P_NTERMS]))), (u2, "u2", (n,))):
+        if not (
+            type(arr) is np.ndarray and arr.dtype == np.float64 and arr.flags.writeable
+            and arr.flags.c_contiguous and arr.shape == shape
+        ):  # fmt: skip
+            got = arr.shape if isinstance(arr, np.ndarray) else type(arr).__name__
+            raise shape_error(name, str(shape), got, " (writable float64, C order)")
+    term_monomials_kernel(x, inputs, p, c, out, u2)
+    if not (np.isfinite(out).all() and np.isfinite(u2).all()):
+        i = int(np.argwhere(~(np.isfinite(out).all(axis=1) & np.isfinite(u2)))[0, 0])
+        raise ValueError(
+            f"the regressors are not finite at row {i}: the state, input or current is beyond "
+            "what the model can evaluate"
+        )
+
+
+@kernel
+def term_monomials_kernel(x, inputs, p, c, out, u2):  # pragma: no cover - jit
+    """:func:`term_monomials` without its checks."""
     scratch = np.empty(3)
     for i in range(x.shape[0]):
         ur, vr, _, _ = relative_motion(x[i], c, scratch)
