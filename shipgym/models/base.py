@@ -4,10 +4,16 @@ A :class:`ShipModel` couples one derivative kernel (``shipgym.models.integrate.r
 its packed parameters, and offers the batched derivative, one RK4 step and whole-trajectory
 simulation as a :class:`SimulationResult` (time, states and inputs with names, like a
 python-control response object).
+
+Every method checks its arguments in Python before a compiled kernel sees them (the kernels do
+no bounds checking): shapes against the model's states and inputs, real numbers (``TypeError``
+otherwise), finite values, a finite step > 0 and a step RK4 can take at the state (``ValueError``
+naming the argument, what it was and what was expected). See :class:`ShipModel`, "Checks".
 """
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -17,6 +23,15 @@ import numpy as np
 import numpy.typing as npt
 
 from shipgym.models import integrate
+from shipgym.models._checks import (
+    count,
+    positive_number,
+    real_array,
+    require_finite,
+    shape_error,
+    step_size,
+)
+from shipgym.models.current import Current
 from shipgym.models.mmg import MMG_INPUTS, MMG_STATES, MMGParams, pack_mmg
 from shipgym.models.nomoto import (
     FIRST_ORDER_STATES,
@@ -70,6 +85,23 @@ class SimulationResult:
         )
 
 
+MAX_STEPS = 100_000_000
+"""Most steps one :meth:`ShipModel.simulate` call takes (its result alone would be gigabytes)."""
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _round_down(value: float) -> float:
+    """``value`` rounded down to three significant digits (a step that is safely inside)."""
+    if not value > 0.0:
+        return 0.0
+    scale = 10.0 ** (math.floor(math.log10(value)) - 2)
+    return math.floor(value / scale + 1e-9) * scale
+
+
 @dataclass(frozen=True, eq=False)
 class ShipModel:
     """One vessel model: parameters plus the shared derivative and integrator.
@@ -84,6 +116,26 @@ class ShipModel:
         The model's parameter dataclass (yaw parameters for the Nomoto family).
     gear, surge : SteeringGear, SurgeModel or None
         Actuator and speed models of the Nomoto family (``None`` for the 3-DOF models).
+
+    Checks
+    ------
+    States, inputs and currents must be real numbers (``TypeError`` for bool, complex, strings,
+    objects) of the model's shape and finite; ``dt`` a real, finite number > 0 (``ValueError``
+    naming what was wrong). A policy given to :meth:`simulate` must return a finite input of
+    shape ``(nu,)``.
+
+    A fixed-step RK4 beyond its stability limit does not give a rough answer but one that grows
+    without bound (NaN or 1e235 after a while), so a step beyond the limit is refused, not
+    warned about: :meth:`simulate` and :meth:`step` raise ``ValueError("dt=5 s is beyond the
+    stable RK4 step of model 'rvg3dof' (about 2.79 s at this state); use dt <= 2.78")``. The
+    limit is :meth:`stable_step`, from the eigenvalues of the linearisation at the state;
+    :meth:`simulate` checks it at the initial state and input, :meth:`step` whenever ``dt``
+    exceeds the model's stable step at rest (so the usual small steps cost nothing). The
+    fastest modes of the shipped models are their actuators: 5.57 s for the Nomoto family
+    (steering gear, 2 s), 2.79 s for the RVG (pods, 1 s), 0.139 s for the 7 m KVLCC2 (rudder,
+    0.05 s). A state that still becomes non-finite (an input that drives the model out of its
+    range, a stiffer state later in a run) raises ``ValueError`` naming the time and, when that
+    is the cause, the stable step there, instead of returning NaN.
     """
 
     name: str
@@ -97,6 +149,8 @@ class ShipModel:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
+        if not isinstance(self.name, str) or self.name not in MODEL_NAMES:
+            raise ValueError(f"unknown model {self.name!r}; expected one of {MODEL_NAMES}")
         if self.name == "rvg3dof":
             set_(self, "p", pack_rvg(self.params))
             set_(self, "state_names", RVG_STATES)
@@ -110,12 +164,13 @@ class ShipModel:
             set_(self, "state_names", VMM_STATES)
             set_(self, "input_names", VMM_INPUTS)
         else:
-            assert self.gear is not None and self.surge is not None
+            _check_actuators(self.gear, self.surge, required=True)
             set_(self, "p", pack_nomoto(self.params, self.gear, self.surge))
             second = self.name in ("nomoto2", "bech")
             set_(self, "state_names", SECOND_ORDER_STATES if second else FIRST_ORDER_STATES)
             set_(self, "input_names", NOMOTO_INPUTS)
-        set_(self, "model_id", MODEL_NAMES.index(self.name))
+        set_(self, "model_id", integrate.MODEL_IDS[self.name])
+        integrate.check_parameters(self.model_id, self.p)
         self.p.flags.writeable = False
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -142,31 +197,66 @@ class ShipModel:
                 f"model {self.name!r} has no state {name!r}; states: {self.state_names}"
             ) from None
 
-    def _batch(self, x: npt.ArrayLike, u: npt.ArrayLike, current: npt.ArrayLike | None):
-        x = np.array(x, dtype=np.float64, ndmin=2)
-        u = np.array(u, dtype=np.float64, ndmin=2)
+    # ---------------------------------------------------------------------------------------
+    # argument checks (Python, before any kernel)
+    # ---------------------------------------------------------------------------------------
+
+    def _currents(self, current: Any, n: int) -> np.ndarray:
+        if current is None:
+            return np.zeros((n, 2))
+        if isinstance(current, Current):
+            current = current.ned
+        c = np.array(real_array(current, "current"), dtype=np.float64, order="C", ndmin=2)
+        if c.shape == (1, 2) and n != 1:
+            c = np.repeat(c, n, axis=0)
+        if c.shape != (n, 2):
+            raise ValueError(f"current must be (n, 2) north/east [m/s] with n={n}, got {c.shape}")
+        require_finite(c, "current", ("north", "east"))
+        return c
+
+    def _batch(
+        self,
+        x: npt.ArrayLike,
+        u: npt.ArrayLike,
+        current: npt.ArrayLike | Current | None,
+        finite_x: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Checked ``(n, nx)`` states (a copy), ``(n, nu)`` inputs and ``(n, 2)`` currents
+        (``finite_x=False``: the caller checks the states' finiteness itself)."""
+        x = np.array(real_array(x, "state x"), dtype=np.float64, order="C", ndmin=2)
         if x.ndim != 2 or x.shape[1] != self.nx:
             raise ValueError(
                 f"state must have shape (n, {self.nx}) {self.state_names}, got {x.shape}"
             )
         n = x.shape[0]
-        if u.shape == (1, self.nu) and n > 1:
+        u = np.array(real_array(u, "input u"), dtype=np.float64, order="C", ndmin=2)
+        if u.shape == (1, self.nu) and n != 1:
             u = np.repeat(u, n, axis=0)
         if u.shape != (n, self.nu):
             raise ValueError(
                 f"input must have shape ({n}, {self.nu}) {self.input_names}, got {u.shape}"
             )
-        if current is None:
-            c = np.zeros((n, 2))
-        else:
-            c = np.array(current, dtype=np.float64, ndmin=2)
-            if c.shape == (1, 2) and n > 1:
-                c = np.repeat(c, n, axis=0)
-            if c.shape != (n, 2):
-                raise ValueError(
-                    f"current must be (n, 2) north/east [m/s] with n={n}, got {c.shape}"
-                )
+        c = self._currents(current, n)
+        if finite_x:
+            require_finite(x, "state x", self.state_names)
+        require_finite(u, "input u", self.input_names)
         return x, u, c
+
+    def _single(
+        self, value: Any, name: str, width: int, names: tuple[str, ...], hint: str = ""
+    ) -> np.ndarray:
+        """One ship's state or input as a checked ``(1, width)`` copy."""
+        arr = np.array(real_array(value, name), dtype=np.float64, order="C")
+        if arr.shape == (width,):
+            arr = arr[None]
+        elif arr.shape != (1, width):
+            raise shape_error(name, f"({width},)", arr.shape, f" {names}{hint}")
+        require_finite(arr[0], name, names)
+        return arr
+
+    # ---------------------------------------------------------------------------------------
+    # the derivative, its Jacobians and the stable step
+    # ---------------------------------------------------------------------------------------
 
     def deriv(
         self, x: npt.ArrayLike, u: npt.ArrayLike, current: npt.ArrayLike | None = None
@@ -179,18 +269,52 @@ class ShipModel:
             States, shape ``(n, nx)`` (or ``(nx,)`` for one ship).
         u : array_like
             Inputs, shape ``(n, nu)`` or ``(nu,)``.
-        current : array_like, optional
+        current : array_like or Current, optional
             North/east current [m/s], shape ``(n, 2)`` or ``(2,)``; none by default.
 
         Returns
         -------
         numpy.ndarray
             ``x'``, shape ``(n, nx)``.
+
+        Raises
+        ------
+        TypeError, ValueError
+            For arguments that are not real, of the wrong shape or not finite, and when the
+            derivative is not finite (a state or input beyond what the model can evaluate).
         """
         xb, ub, cb = self._batch(x, u, current)
         out = np.empty_like(xb)
-        integrate.rhs(self.model_id, xb, ub, self.p, cb, out)
+        integrate.rhs_kernel(self.model_id, xb, ub, self.p, cb, out)
+        if not np.isfinite(out).all():
+            i = int(np.argwhere(~np.isfinite(out))[0, 0])
+            raise ValueError(
+                f"the derivative is not finite at row {i}: state {_short(xb[i].tolist())}, "
+                f"input {_short(ub[i].tolist())} are beyond what model {self.name!r} can "
+                "evaluate"
+            )
         return out
+
+    def _jacobians(
+        self, xb: np.ndarray, ub: np.ndarray, cb: np.ndarray, eps: float, inputs: bool
+    ) -> np.ndarray:
+        """``(n, nx, nx [+ nu])`` central-difference Jacobians ``[df/dx, df/du]`` of each row."""
+        n, nx = xb.shape
+        n_cols = nx + (self.nu if inputs else 0)
+        base = np.concatenate((xb, ub), axis=1)[:, :n_cols]
+        h = eps * np.maximum(1.0, np.abs(base))  # (n, n_cols)
+        z = np.repeat(np.concatenate((xb, ub), axis=1)[:, None, :], 2 * n_cols, axis=1)
+        cols = np.arange(n_cols)
+        z[:, 2 * cols, cols] += h
+        z[:, 2 * cols + 1, cols] -= h
+        z = z.reshape(n * 2 * n_cols, nx + self.nu)
+        zx = np.ascontiguousarray(z[:, :nx])
+        zu = np.ascontiguousarray(z[:, nx:])
+        c = np.repeat(cb, 2 * n_cols, axis=0)
+        f = np.empty_like(zx)
+        integrate.rhs_kernel(self.model_id, zx, zu, self.p, c, f)
+        f = f.reshape(n, 2 * n_cols, nx)
+        return np.swapaxes((f[:, 0::2] - f[:, 1::2]) / (2.0 * h[:, :, None]), 1, 2)
 
     def linearize(
         self,
@@ -207,36 +331,156 @@ class ShipModel:
             State, shape ``(nx,)``.
         u0 : array_like
             Input, shape ``(nu,)``.
-        current : array_like, optional
-            North/east current [m/s].
+        current : array_like or Current, optional
+            North/east current [m/s], shape ``(2,)``.
         eps : float
-            Relative perturbation (scaled by ``max(1, |value|)`` per entry).
+            Relative perturbation (scaled by ``max(1, |value|)`` per entry), finite and > 0.
 
         Returns
         -------
         A, B : numpy.ndarray
             Shapes ``(nx, nx)`` and ``(nx, nu)``.
+
+        Raises
+        ------
+        TypeError, ValueError
+            For arguments that are not real, of the wrong shape or not finite, and when the
+            Jacobian is not finite.
         """
-        x0b, u0b, _ = self._batch(x0, u0, current)
-        n_cols = self.nx + self.nu
-        z = np.tile(np.concatenate((x0b[0], u0b[0])), (2 * n_cols, 1))
-        h = eps * np.maximum(1.0, np.abs(z[0]))
-        for k in range(n_cols):
-            z[2 * k, k] += h[k]
-            z[2 * k + 1, k] -= h[k]
-        _, _, c = self._batch(z[:, : self.nx], z[:, self.nx :], current)
-        f = self.deriv(z[:, : self.nx], z[:, self.nx :], c)
-        jac = ((f[0::2] - f[1::2]) / (2.0 * h[:, None])).T
+        x = self._single(x0, "x0", self.nx, self.state_names)
+        u = self._single(u0, "u0", self.nu, self.input_names)
+        c = self._currents(current, 1)
+        eps = positive_number(eps, "eps")
+        with np.errstate(all="ignore"):  # an overflow shows as a non-finite Jacobian
+            jac = self._jacobians(x, u, c, eps, inputs=True)[0]
+        if not np.isfinite(jac).all():
+            raise ValueError(
+                f"the Jacobian of model {self.name!r} is not finite at x0={_short(x[0].tolist())},"
+                f" u0={_short(u[0].tolist())}: the state or input is beyond what it can evaluate"
+            )
         return jac[:, : self.nx], jac[:, self.nx :]
+
+    def stable_step(
+        self, x: npt.ArrayLike, u: npt.ArrayLike, current: npt.ArrayLike | None = None
+    ) -> float:
+        """Largest RK4 step [s] that is stable at ``(x, u)``.
+
+        The step :func:`~shipgym.models.integrate.rk4_stable_step` of the eigenvalues of
+        ``df/dx`` (:meth:`linearize`) at each row of the batch and at rest (zero state, input
+        and current), the smallest of them. Rest counts because a rate-limited actuator (a
+        steering gear turning at its rate limit) hides its own fast mode from the linearisation
+        at that state, and it returns to its linear range as soon as it reaches the command; at
+        rest every actuator is in its linear range.
+
+        ``inf`` when no decaying mode limits the step. The fastest modes of the shipped models
+        are their actuators (class docstring), so the value hardly changes with the state.
+        """
+        xb, ub, cb = self._batch(x, u, current)
+        return self._stable_step(xb, ub, cb)
+
+    def _linear_stable_step(self, xb: np.ndarray, ub: np.ndarray, cb: np.ndarray) -> float:
+        """:func:`rk4_stable_step` of the Jacobians at the rows (``inf`` where not finite)."""
+        if xb.shape[0] == 0:
+            return math.inf
+        with np.errstate(all="ignore"):
+            a = self._jacobians(xb, ub, cb, 1e-6, inputs=False)
+        if not np.isfinite(a).all():
+            return math.inf
+        return integrate.rk4_stable_step(np.linalg.eigvals(a))
+
+    def _stable_step(self, xb: np.ndarray, ub: np.ndarray, cb: np.ndarray) -> float:
+        return min(self._linear_stable_step(xb, ub, cb), self._rest_stable_step())
+
+    def _rest_stable_step(self) -> float:
+        """The stable step at rest (zero state, input and current), computed once."""
+        value = self.__dict__.get("_rest_step")
+        if value is None:
+            zero_x, zero_u = np.zeros((1, self.nx)), np.zeros((1, self.nu))
+            value = self._linear_stable_step(zero_x, zero_u, np.zeros((1, 2)))
+            object.__setattr__(self, "_rest_step", value)
+        return value
+
+    def _beyond(self, dt: float, limit: float) -> str:
+        return (
+            f"dt={dt:g} s is beyond the stable RK4 step of model {self.name!r} (about "
+            f"{limit:.3g} s at this state); use dt <= {_round_down(limit):.3g}"
+        )
+
+    def _check_step(self, dt: float, xb: np.ndarray, ub: np.ndarray, cb: np.ndarray) -> None:
+        limit = self._stable_step(xb, ub, cb)
+        if dt > limit:
+            raise ValueError(self._beyond(dt, limit))
+
+    def _not_finite(
+        self, dt: float, when: str, x: np.ndarray, u: np.ndarray, c: np.ndarray
+    ) -> ValueError:
+        """The error for a state that became non-finite in the step from ``x`` (one row)."""
+        message = f"the state of model {self.name!r} is not finite after the step {when}"
+        try:
+            limit = self._stable_step(x[None], u[None], c[None])
+        except (ValueError, np.linalg.LinAlgError):
+            limit = math.inf
+        if dt > limit:
+            return ValueError(f"{message}: {self._beyond(dt, limit)}")
+        return ValueError(
+            f"{message}: the state before it, {_short(x.tolist())}, with input "
+            f"{_short(u.tolist())} is beyond what the model can evaluate"
+        )
+
+    # ---------------------------------------------------------------------------------------
+    # integration
+    # ---------------------------------------------------------------------------------------
 
     def step(
         self, x: npt.ArrayLike, u: npt.ArrayLike, dt: float, current: npt.ArrayLike | None = None
     ) -> np.ndarray:
-        """One RK4 step of ``dt`` [s] from ``x`` (returns a new ``(n, nx)`` array)."""
-        xb, ub, cb = self._batch(x, u, current)
-        xb = xb.copy()
-        integrate.rk4_step(self.model_id, xb, ub, self.p, cb, float(dt))
+        """One RK4 step of ``dt`` [s] from ``x`` (returns a new ``(n, nx)`` array).
+
+        Parameters
+        ----------
+        x, u, current
+            As in :meth:`deriv`.
+        dt : float
+            Step [s]: finite, > 0 and within the model's stable step at rest (:meth:`stable_step`
+            is never larger; the state's own limit is not computed here, on the hot path: a
+            state that becomes non-finite raises instead).
+
+        Raises
+        ------
+        TypeError, ValueError
+            For bad arguments (class docstring, "Checks"), a step beyond the stable RK4 step
+            and a state that is not finite after the step.
+        """
+        h = step_size(dt)
+        # a NaN or inf in x stays in the result, which is checked after the step (one check
+        # less on this hot path); the inputs are checked before (a limiter can hide a NaN)
+        xb, ub, cb = self._batch(x, u, current, finite_x=False)
+        if h > self._rest_stable_step():  # stable_step is never larger
+            raise ValueError(self._beyond(h, self._rest_stable_step()))
+        integrate.rk4_step_kernel(self.model_id, xb, ub, self.p, cb, h)
+        if not np.isfinite(xb).all():
+            i = int(np.argwhere(~np.isfinite(xb))[0, 0])
+            x0, _, _ = self._batch(x, u, current)  # raises for a non-finite state x
+            raise self._not_finite(h, f"of dt={h:g} s (row {i})", x0[i], ub[i], cb[i])
         return xb
+
+    def _policy_input(self, value: Any, t: float) -> np.ndarray:
+        try:
+            arr = real_array(value, "policy output")
+        except TypeError:
+            arr = None
+        if (
+            arr is None
+            or arr.shape not in ((self.nu,), (1, self.nu))
+            or not (np.isfinite(arr).all())
+        ):
+            got = "" if arr is None else f" (shape {arr.shape})"
+            raise ValueError(
+                f"the policy must return an array of shape ({self.nu},) {self.input_names} of "
+                f"finite numbers; at t={t:g} s it returned {type(value).__name__} "
+                f"{_short(value)}{got}"
+            )
+        return arr.reshape(self.nu)
 
     def simulate(
         self,
@@ -251,49 +495,89 @@ class ShipModel:
         Parameters
         ----------
         x0 : array_like
-            Initial state, shape ``(nx,)``.
+            Initial state, shape ``(nx,)`` (one ship; :meth:`step` takes a batch).
         inputs : array_like or callable
             Either an ``(n_steps, nu)`` array of inputs held over each step, or a function
-            ``(t, x) -> u`` called at the start of each step (a controller in the loop).
+            ``(t, x) -> u`` called at the start of each step (a controller in the loop) that
+            returns a finite input of shape ``(nu,)``.
         dt : float
-            Step [s].
+            Step [s]: finite, > 0 and within :meth:`stable_step` at ``x0`` and the first
+            input.
         n_steps : int, optional
-            Number of steps; required when ``inputs`` is a callable.
-        current : array_like, optional
+            Number of steps (at most :data:`MAX_STEPS`); required when ``inputs`` is a
+            callable.
+        current : array_like or Current, optional
             North/east current [m/s], shape ``(2,)``.
 
         Returns
         -------
         SimulationResult
+
+        Raises
+        ------
+        TypeError, ValueError
+            For bad arguments (class docstring, "Checks"), a policy output that is not a finite
+            ``(nu,)`` input, a step beyond the stable RK4 step and a state that becomes
+            non-finite (naming the time).
         """
-        if not (np.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be a finite step > 0 s, got {dt!r}")
+        dt = step_size(dt)
+        x = self._single(
+            x0, "x0", self.nx, self.state_names,
+            ": one ship's state (simulate runs one ship; step() takes a batch)",
+        )  # fmt: skip
+        c = self._currents(current, 1)
         if callable(inputs):
-            if n_steps is None or n_steps < 1:
-                raise ValueError(f"n_steps must be >= 1 when inputs is a function, got {n_steps!r}")
+            if n_steps is None:
+                raise ValueError("n_steps must be >= 1 when inputs is a function, got None")
+            n_steps = count(n_steps, "n_steps", 1, MAX_STEPS)
             u_seq = np.zeros((n_steps, self.nu))
             policy = inputs
         else:
-            u_seq = np.array(inputs, dtype=np.float64, ndmin=2)
-            if u_seq.shape[1] != self.nu:
-                raise ValueError(f"inputs must have shape (n_steps, {self.nu}), got {u_seq.shape}")
-            n_steps = u_seq.shape[0] if n_steps is None else n_steps
-            if n_steps != u_seq.shape[0]:
+            u_seq = np.array(real_array(inputs, "inputs"), dtype=np.float64, order="C", ndmin=2)
+            if u_seq.ndim != 2 or u_seq.shape[1] != self.nu:
+                raise shape_error(
+                    "inputs", f"(n_steps, {self.nu})", u_seq.shape, f" {self.input_names}"
+                )
+            if n_steps is None:
+                n_steps = u_seq.shape[0]
+            elif count(n_steps, "n_steps", 0, MAX_STEPS) != u_seq.shape[0]:
                 raise ValueError(f"n_steps={n_steps} but inputs has {u_seq.shape[0]} rows")
+            if n_steps > MAX_STEPS:
+                raise ValueError(f"inputs must have at most {MAX_STEPS} rows, got {n_steps}")
+            require_finite(u_seq, "inputs", self.input_names)
             policy = None
-        x, _, c = self._batch(x0, np.zeros(self.nu), current)
-        x = x.copy()
         states = np.empty((n_steps + 1, self.nx))
         states[0] = x[0]
-        time = np.arange(n_steps + 1) * dt
+        with np.errstate(over="ignore"):
+            time = np.arange(n_steps + 1) * dt
+        if not math.isfinite(time[-1]):
+            raise ValueError(f"dt * n_steps must be a finite time, got {dt!r} s * {n_steps}")
         u = np.empty((1, self.nu))
         for k in range(n_steps):
             if policy is not None:
-                u_seq[k] = np.asarray(policy(time[k], x[0].copy()), dtype=np.float64)
+                if k > 0 and not np.isfinite(x).all():
+                    raise self._not_finite(
+                        dt, f"to t={time[k]:g} s (dt={dt:g} s)", states[k - 1], u_seq[k - 1], c[0]
+                    )
+                u_seq[k] = self._policy_input(policy(time[k], x[0].copy()), time[k])
             u[0] = u_seq[k]
-            integrate.rk4_step(self.model_id, x, u, self.p, c, dt)
+            if k == 0:
+                self._check_step(dt, x, u, c)
+            integrate.rk4_step_kernel(self.model_id, x, u, self.p, c, dt)
             states[k + 1] = x[0]
+        if not np.isfinite(states).all():
+            k = int(np.argwhere(~np.isfinite(states))[0, 0])
+            raise self._not_finite(
+                dt, f"to t={time[k]:g} s (dt={dt:g} s)", states[k - 1], u_seq[k - 1], c[0]
+            )
         return SimulationResult(time, states, u_seq, self.state_names, self.input_names)
+
+
+def _check_actuators(gear: Any, surge: Any, required: bool) -> None:
+    """``TypeError`` for a steering gear or surge model of the wrong type."""
+    for value, cls, label in ((gear, SteeringGear, "gear"), (surge, SurgeModel, "surge")):
+        if (value is not None or required) and not isinstance(value, cls):
+            raise TypeError(f"{label} must be a {cls.__name__}, got {_short(value)}")
 
 
 _DEFAULT_YAW = {
@@ -331,11 +615,17 @@ def make_model(
 
     Raises
     ------
+    TypeError
+        For a name that is not a string, or a ``gear`` or ``surge`` of the wrong type (both are
+        ignored by the 3-DOF models).
     ValueError
         For an unknown name or parameters of the wrong type.
     """
+    if not isinstance(name, str):
+        raise TypeError(f"model name must be a str, one of {MODEL_NAMES}, got {_short(name)}")
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
+    _check_actuators(gear, surge, required=False)
     if name == "vmm":
         if isinstance(params, str | os.PathLike):
             params = VMMParams.load(params)
