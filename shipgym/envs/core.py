@@ -1,17 +1,19 @@
 """Generic single and NumPy-batched vector environments around a :class:`~shipgym.envs.tasks.Task`.
 
 ``ShipEnv`` is a :class:`gymnasium.Env` holding a task of one row; ``ShipVectorEnv`` is a
-:class:`gymnasium.vector.VectorEnv` holding a task of ``num_envs`` rows with next-step
-autoreset (as Gymnasium's ``CartPoleVectorEnv``). Both step through the same task kernel, so
-the physics exists once. Sub-env ``i`` of a vector env reset with seed ``s`` draws from
+:class:`gymnasium.vector.VectorEnv` holding a task of ``num_envs`` rows with its own autoreset
+(as Gymnasium's ``CartPoleVectorEnv``). Both step through the same task kernel, so the physics
+exists once. Sub-env ``i`` of a vector env reset with seed ``s`` draws from
 ``np_random(s + i)``, the generator of a single env reset with seed ``s + i`` (the convention of
 ``SyncVectorEnv``), so the two produce identical trajectories under identical actions.
 
-The vector env autoresets on the next step by default. With
-``autoreset_mode=AutoresetMode.SAME_STEP`` a finished sub-env is reset inside the step that
-ended it: the returned observation is the new episode's first one and the last observation of
-the finished episode is in ``info["final_obs"]`` (rows flagged by ``info["_final_obs"]``), the
-form that stable-baselines3's ``VecEnv`` needs (:mod:`shipgym.rl.vec_env`).
+The vector env behaves as Gymnasium's ``SyncVectorEnv`` of single envs, ``info`` included
+(the same keys, ``_key`` flags, dtypes and values; :meth:`Task.batch_info` builds it for all
+sub-envs with NumPy), in both autoreset modes: next-step (the default) and same-step
+(``autoreset_mode=AutoresetMode.SAME_STEP``: the finished episode's last observation and info
+in ``info["final_obs"]`` and ``info["final_info"]``, the form that stable-baselines3's
+``VecEnv`` needs, :mod:`shipgym.rl.vec_env`). ``keep_options=True`` makes autoresets use the
+options of the last ``reset(options=...)``, which ``SyncVectorEnv`` forgets.
 """
 
 from __future__ import annotations
@@ -179,7 +181,49 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
 
 
 class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
-    """NumPy-batched vector env with next-step autoreset over the same task kernel."""
+    """NumPy-batched vector env over the same task kernel as the single env.
+
+    Equivalent to Gymnasium's ``SyncVectorEnv`` of the single env (``gymnasium.make_vec(id,
+    num_envs, vectorization_mode="sync")``) in observations, rewards, flags and ``info``, but
+    one kernel call steps every sub-env.
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of sub-envs (>= 1).
+    max_episode_steps : int, optional
+        Steps after which a sub-env is truncated; default the registered limit of the task.
+    render_mode : {None, "rgb_array"}
+        ``"rgb_array"`` draws sub-env 0.
+    autoreset_mode : AutoresetMode or str
+        ``AutoresetMode.NEXT_STEP`` (default): a sub-env that ended is reset by the next
+        ``step``, which returns its new episode's first observation with reward 0 and both
+        flags False (its action is ignored). ``AutoresetMode.SAME_STEP``: it is reset inside
+        the step that ended it, which returns the new episode's first observation; the
+        finished episode's last observation and ``info`` are in ``info["final_obs"]`` and
+        ``info["final_info"]`` (rows flagged by ``info["_final_obs"]`` and
+        ``info["_final_info"]``), the form stable-baselines3 needs (:mod:`shipgym.rl.vec_env`).
+    keep_options : bool
+        What an autoreset does with the options of the last ``reset(options=...)``. False (the
+        default, Gymnasium's ``SyncVectorEnv`` behaviour): an autoreset draws a fresh scenario
+        as ``env.reset()`` does, so the options shape the first episode of each sub-env only.
+        True: every autoreset uses them too (a fixed current, setpoints, waypoints or target
+        for the whole run), until a ``reset`` with other options or none.
+    **task_kwargs
+        Keyword arguments of the task (as for the single env).
+
+    Notes
+    -----
+    ``info`` follows Gymnasium's vector convention: each key of the single env's ``info``
+    (``state``, ``current_speed``, ``current_direction``, ``termination_reason`` and the task
+    metrics) holds an array with one entry per sub-env (``termination_reason`` an object array
+    of strings) and ``info["_key"]`` a boolean array flagging the sub-envs that have it (all of
+    them, except in ``final_info``). ``reset`` returns the same keys. The entries describe
+    each sub-env after the step: on a next-step autoreset, the new episode (as
+    ``env.reset()``'s info would); in same-step mode the finished episode's are in
+    ``final_info``, whose entries of sub-envs that did not finish are zero (None for strings).
+    The arrays are built with NumPy for all sub-envs at once and are new at every call.
+    """
 
     metadata: ClassVar[dict[str, Any]] = {
         "render_modes": ["rgb_array"],
@@ -193,6 +237,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        keep_options: bool = False,
         **task_kwargs: Any,
     ) -> None:
         modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
@@ -204,7 +249,10 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             raise ValueError(
                 f"autoreset_mode must be one of {[m.value for m in modes]}, got {autoreset_mode!r}"
             )
+        if not isinstance(keep_options, bool | np.bool_):
+            raise ValueError(f"keep_options must be True or False, got {keep_options!r}")
         self.autoreset_mode = mode
+        self.keep_options = bool(keep_options)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.task = self.task_cls(num_envs, **task_kwargs)
         self.num_envs = int(num_envs)
@@ -225,6 +273,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._rngs = [seeding.np_random(None)[0] for _ in range(self.num_envs)]
         self._prev_done = np.zeros(self.num_envs, dtype=np.bool_)
+        #: Options of the autoresets: those of the last reset with ``keep_options``, else None.
+        self._autoreset_options: dict[str, Any] | None = None
         self._single: ShipEnv | None = None
         self._needs_reset = True
 
@@ -238,9 +288,42 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         if needs_reset and self._needs_reset:
             raise gym.error.ResetNeeded(f"Cannot call env.{call}() before calling env.reset()")
 
+    def _info(self) -> dict[str, Any]:
+        """The vector ``info`` of every sub-env: each key of the single env's info and its
+        ``_key`` flags (all set)."""
+        info = self.task.batch_info()
+        for key in tuple(info):
+            info[f"_{key}"] = np.ones(self.num_envs, dtype=np.bool_)
+        return info
+
+    def _final(self, obs: np.ndarray, done: np.ndarray) -> dict[str, Any]:
+        """``final_obs`` and ``final_info`` of the sub-envs flagged by ``done`` (before their
+        reset), as ``SyncVectorEnv`` builds them: object array of observations, nested info
+        whose entries of the other sub-envs are zero (None for objects)."""
+        rows = np.flatnonzero(done)
+        final_obs = np.full(self.num_envs, None, dtype=object)
+        for i in rows:
+            final_obs[i] = obs[i]
+        final_info = self.task.batch_info()
+        running = ~done
+        for key in tuple(final_info):
+            value = final_info[key]
+            value[running] = None if value.dtype == object else 0
+            final_info[f"_{key}"] = done.copy()
+        return {
+            "final_obs": final_obs,
+            "_final_obs": done.copy(),
+            "final_info": final_info,
+            "_final_info": done.copy(),
+        }
+
     def reset(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Reset every sub-env; ``options`` as for the single env, for every sub-env.
+
+        Whether the autoresets that follow use ``options`` too is ``keep_options``.
+        """
         self._check_open("reset", needs_reset=False)
         if seed is not None:
             seeds = (
@@ -252,9 +335,13 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
                 raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
             self._rngs = [seeding.np_random(s)[0] for s in seeds]
         self.task.reset_rows(range(self.num_envs), self._rngs, options)
+        self._autoreset_options = dict(options) if self.keep_options and options else None
         self._prev_done[:] = False
         self._needs_reset = False
-        return self.task.obs.astype(np.float32), {}
+        return self.task.obs.astype(np.float32), self._info()
+
+    def _autoreset(self, rows: np.ndarray) -> None:
+        self.task.reset_rows(rows, [self._rngs[i] for i in rows], self._autoreset_options)
 
     def step(
         self, actions: Any
@@ -270,23 +357,22 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         terminated = task.term.copy()
         truncated = task.steps >= self.max_episode_steps
         rewards = task.rew.copy()
-        info: dict[str, Any] = {"reason": task.reason.copy()}
         if self.autoreset_mode is AutoresetMode.SAME_STEP:
             done = terminated | truncated
-            if done.any():
-                rows = np.flatnonzero(done)
-                info["final_obs"] = task.obs.astype(np.float32)
-                info["_final_obs"] = done
-                task.reset_rows(rows, [self._rngs[i] for i in rows])
+            if not done.any():
+                return task.obs.astype(np.float32), rewards, terminated, truncated, self._info()
+            final = self._final(task.obs.astype(np.float32), done)
+            self._autoreset(np.flatnonzero(done))
+            info = self._info()
+            info.update(final)
             return task.obs.astype(np.float32), rewards, terminated, truncated, info
         if self._prev_done.any():
-            rows = np.flatnonzero(self._prev_done)
-            task.reset_rows(rows, [self._rngs[i] for i in rows])
+            self._autoreset(np.flatnonzero(self._prev_done))
             rewards[self._prev_done] = 0.0
             terminated[self._prev_done] = False
             truncated[self._prev_done] = False
         self._prev_done = terminated | truncated
-        return task.obs.astype(np.float32), rewards, terminated, truncated, info
+        return task.obs.astype(np.float32), rewards, terminated, truncated, self._info()
 
     def render(self) -> np.ndarray | None:
         """Top-down view of sub-env 0 (``rgb_array`` only)."""

@@ -247,8 +247,13 @@ class Task:
         """Set the task quantities (setpoints, path, target) of ``rows``."""
         raise NotImplementedError
 
-    def metrics(self, i: int) -> dict[str, Any]:
-        """Task metrics of row ``i`` for ``info``."""
+    def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
+        """Task metrics of ``rows`` for ``info``, computed once for the single and vector env.
+
+        ``rows`` is a slice or an index array (each metric an array with one entry per row,
+        float64, int64 or bool, possibly a view of the task's arrays: :meth:`batch_info`
+        copies) or one row index (NumPy scalars).
+        """
         raise NotImplementedError
 
     # --- shared ------------------------------------------------------------------------------
@@ -409,6 +414,39 @@ class Task:
         info.update(self.metrics(i))
         return info
 
+    def metrics(self, i: int) -> dict[str, Any]:
+        """Task metrics of row ``i`` for ``info``, as Python scalars (float, int, bool)."""
+        return {key: value.item() for key, value in self.batch_metrics(i).items()}
+
+    def batch_info(self, rows: slice | np.ndarray = slice(None)) -> dict[str, np.ndarray]:
+        """The ``info`` of ``rows`` (default all) as arrays: entry ``k`` of each is the value
+        of ``info(i)`` for the ``k``-th row ``i``.
+
+        The dtypes are those Gymnasium's ``SyncVectorEnv`` gives the single env's values
+        (float64, int64, bool; ``object`` holding ``str`` for ``termination_reason``). Every
+        array is new, so it stays valid after later steps. A slice is the fast way to ask for
+        all rows (copies instead of fancy indexing).
+        """
+        reason = self.reason[rows]
+        if reason.any():
+            names = _REASON_NAMES[reason]
+        else:  # the usual step: filling is cheaper than indexing an object array
+            names = np.empty(reason.shape, dtype=object)
+            names.fill(kernels.REASONS[0])
+        info = {
+            "state": np.array(self.x[rows]),
+            "current_speed": np.array(self.current[rows, 0]),
+            "current_direction": np.array(self.current[rows, 1]),
+            "termination_reason": names,
+        }
+        for key, value in self.batch_metrics(rows).items():
+            info[key] = np.array(value)
+        return info
+
+
+#: ``kernels.REASONS`` as an object array: ``_REASON_NAMES[reason]`` names a batch of codes.
+_REASON_NAMES = np.array(kernels.REASONS, dtype=object)
+
 
 class ScheduleMixin:
     """Setpoints held ``setpoint_interval`` seconds each, the last one to the end."""
@@ -477,11 +515,10 @@ class HeadingTask(ScheduleMixin, Task):
             setpoints = ssa(self.x[rows, self.ipsi][:, None] + np.cumsum(changes, axis=1))
         self._set_schedule(rows, setpoints)
 
-    def metrics(self, i: int) -> dict[str, Any]:
-        return {
-            "heading_error": float(self.obs[i, 0]),
-            "heading_setpoint": self.current_setpoint(i, int(self.steps[i])),
-        }
+    def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
+        idx = np.arange(self.n)[rows]  # the setpoint is picked per row: an index, not a slice
+        held = np.minimum(self.steps[idx] // self.hold_steps, self.max_setpoints - 1)
+        return {"heading_error": self.obs[rows, 0], "heading_setpoint": self.schedule[idx, held]}
 
 
 class NomotoHeadingTask(HeadingTask):
@@ -683,8 +720,8 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
             setpoints = _uniform(draws[:, 2:4], *self.speed_range)
         self._set_schedule(rows, setpoints)
 
-    def metrics(self, i: int) -> dict[str, Any]:
-        return {"speed_error": float(self.obs[i, 0]), "speed_setpoint": float(self.obs[i, 3])}
+    def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
+        return {"speed_error": self.obs[rows, 0], "speed_setpoint": self.obs[rows, 3]}
 
 
 class RVGPathTask(RVGMixin, Task):
@@ -840,11 +877,11 @@ class RVGPathTask(RVGMixin, Task):
             self.x[rows, IPSI] = ssa(chi0 + self.x[rows, IPSI])
             self._add_current(rows, options)
 
-    def metrics(self, i: int) -> dict[str, Any]:
+    def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
         return {
-            "cross_track_error": float(self.obs[i, 0]),
-            "segment": int(self.seg[i]),
-            "completed": bool(self.reason[i] == kernels.SUCCESS),
+            "cross_track_error": self.obs[rows, 0],
+            "segment": self.seg[rows],
+            "completed": self.reason[rows] == kernels.SUCCESS,
         }
 
     def waypoints(self, i: int) -> np.ndarray:
@@ -959,6 +996,6 @@ class RVGTargetTask(RVGMixin, Task):
             else self.default_distance
         )
 
-    def metrics(self, i: int) -> dict[str, Any]:
-        err = float(self.obs[i, 4])
-        return {"distance": err + float(self.distance[i]), "distance_error": err}
+    def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
+        err = self.obs[rows, 4]
+        return {"distance": err + self.distance[rows], "distance_error": err}

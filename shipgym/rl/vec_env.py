@@ -7,7 +7,9 @@ kernel call steps every sub-env. The vector env runs with same-step autoreset
 (``AutoresetMode.SAME_STEP``), which is SB3's contract: the observation after a finished
 episode is the new episode's first one, the finished episode's last observation is in
 ``infos[i]["terminal_observation"]``, and ``infos[i]["TimeLimit.truncated"]`` says the episode
-was cut by the time limit (so SB3 bootstraps its value).
+was cut by the time limit (so SB3 bootstraps its value). The vector env's own ``info`` (state,
+current, task metrics, ``final_info``) is not copied into SB3's per-env dicts: that would cost
+a Python dict per sub-env per step.
 
 Seeding follows SB3: ``seed(s)`` makes the next ``reset()`` seed sub-env ``i`` with ``s + i``,
 which is the scenario of a single env reset with seed ``s + i``. With ``fixed_seed=s`` every
@@ -40,8 +42,12 @@ class ShipgymVecEnv(VecEnv):
     fixed_seed : int, optional
         If given, every ``reset()`` seeds sub-env ``i`` with ``fixed_seed + i``.
     reset_options : dict, optional
-        Options for every reset the caller makes (not for autoresets), e.g. a current;
-        SB3's ``set_options`` overrides them for the next reset.
+        Options for every reset the caller makes, e.g. a current; SB3's ``set_options``
+        overrides them for the next reset. Autoresets draw fresh scenarios unless
+        ``keep_options``.
+    keep_options : bool
+        If True, every autoreset uses the options of the last reset too (the vector env's
+        ``keep_options``), so every episode of the run has e.g. the given current.
     **env_kwargs
         Keyword arguments of the env (e.g. ``max_current_speed``).
     """
@@ -52,6 +58,7 @@ class ShipgymVecEnv(VecEnv):
         num_envs: int = 16,
         fixed_seed: int | None = None,
         reset_options: dict[str, Any] | None = None,
+        keep_options: bool = False,
         **env_kwargs: Any,
     ) -> None:
         if env_id not in ENV_IDS:
@@ -64,6 +71,7 @@ class ShipgymVecEnv(VecEnv):
             num_envs=int(num_envs),
             vectorization_mode="vector_entry_point",
             autoreset_mode=AutoresetMode.SAME_STEP,
+            keep_options=keep_options,
             **env_kwargs,
         )
         self.fixed_seed = fixed_seed
