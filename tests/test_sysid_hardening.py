@@ -259,6 +259,25 @@ def test_fits_refuse_records_without_excitation(what: str, expected: str) -> Non
         identify(rec, "nomoto1", max_effects=0)
 
 
+def test_held_rudder_refused_in_a_steady_turn_but_not_in_a_step_response() -> None:
+    t = 0.5 * np.arange(801)
+    rng = np.random.default_rng(4)
+    steady = Record(
+        time=t,
+        delta=np.full(t.size, 0.2),
+        psi=0.01 * t,
+        r=0.01 + 1e-5 * rng.standard_normal(t.size),
+    )
+    with pytest.raises(ValueError, match=r"the rudder never moves and the yaw rate never change"):
+        identify(steady, "nomoto1", max_effects=0)
+    # a rudder held from t = 0 on a straight course: the transient identifies K and T
+    step = _zigzag()
+    r = 0.1 * 0.2 * (1.0 - np.exp(-step.time / 30.0))
+    psi = np.concatenate(([0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(step.time))))
+    fit = fit_output_error(step.time, np.full(step.n, 0.2), psi, r, "nomoto1")
+    assert fit.values["T"] == pytest.approx(30.0, rel=0.05)
+
+
 def test_every_family_refuses_a_record_without_excitation() -> None:
     rec = _without("all")
     for model in ("nomoto2", "rvg3dof"):

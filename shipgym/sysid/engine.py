@@ -147,7 +147,7 @@ def _check_excitation(runs: Sequence[Record]) -> None:
     excitation_problems`); with several runs, in at least one of them (a straight run beside
     manoeuvres is fine).
     """
-    per_run = [excitation_problems(rec.delta, rec.psi) for rec in runs]
+    per_run = [excitation_problems(rec.delta, rec.psi, rec.r) for rec in runs]
     kinds = [{p.split(" (")[0] for p in problems} for problems in per_run]
     common = set.intersection(*kinds)
     if not common:

@@ -42,8 +42,8 @@ variance per channel). Standard errors are ``s^2 (J^T J)^-1`` at the optimum; th
 white measurement noise and are optimistic when the residual is dominated by model error.
 
 **Excitation.** Both fits (and :func:`shipgym.sysid.engine.identify`, for every model family)
-refuse a record whose rudder never moves or whose heading never changes
-(:func:`check_excitation`: spread between the 1st and 99th percentiles above
+refuse a record whose rudder never moves (stays at zero, or is held in a steady turn) or whose
+heading never changes (:func:`check_excitation`: spread between the 1st and 99th percentiles above
 :data:`RUDDER_EXCITATION` / :data:`HEADING_EXCITATION` and above 6 times the noise estimated
 from second differences) with ``ValueError("not identifiable: no excitation: ...")``: without
 input or response the gain and time constant are not identifiable and the optimiser returns
@@ -175,11 +175,13 @@ def excitation_problems(
 ) -> list[str]:
     """What is missing for a yaw model to be identifiable from a record (empty: nothing).
 
-    The rudder must move (spread above :data:`RUDDER_EXCITATION` and above 6 times its noise)
-    and the ship must turn (heading spread above :data:`HEADING_EXCITATION`, or without a
-    heading the yaw-rate spread above :data:`YAW_RATE_EXCITATION`, again above 6 times the
-    noise). Without either no fit can tell the gain from the time constant: it returns
-    meaningless numbers (T of 1e9 s, K of 1e-40 1/s).
+    The rudder must move (spread above :data:`RUDDER_EXCITATION` and above 6 times its noise;
+    a rudder held away from zero is enough while the yaw rate changes, as in a step response
+    from a straight course, but not in a steady turn) and the ship must turn (heading spread
+    above :data:`HEADING_EXCITATION`, or without a heading the yaw-rate spread above
+    :data:`YAW_RATE_EXCITATION`, again above 6 times the noise). Without either no fit can
+    tell the gain from the time constant: it returns meaningless numbers (T of 1e9 s, K of
+    1e-40 1/s).
 
     Parameters
     ----------
@@ -194,7 +196,29 @@ def excitation_problems(
         One phrase per missing excitation, e.g. ``"the rudder never moves (...)"``.
     """
     out = []
-    checks = [("rudder never moves", "delta", delta, RUDDER_EXCITATION, "deg")]
+    d = np.asarray(delta, dtype=np.float64)
+    if d.size:
+        spread, noise = _spread_and_noise(d)
+        limit = max(RUDDER_EXCITATION, 6.0 * noise)
+        if not spread > limit:
+            level = float(np.median(d))
+            held = (
+                f"delta spans {math.degrees(spread):.3g} deg between its 1st and 99th "
+                f"percentiles around {math.degrees(level):.3g} deg; needs more than "
+                f"{math.degrees(RUDDER_EXCITATION):.3g} deg"
+                + (f" and 6 times its noise {math.degrees(noise):.3g} deg" if noise else "")
+            )
+            if abs(level) <= limit:  # no input at all
+                out.append(f"the rudder never moves ({held})")
+            elif r is not None:  # a held rudder identifies the model only through a transient
+                r_spread, r_noise = _spread_and_noise(np.asarray(r, dtype=np.float64))
+                if not r_spread > max(YAW_RATE_EXCITATION, 6.0 * r_noise):
+                    out.append(
+                        f"the rudder never moves and the yaw rate never changes (a steady turn: "
+                        f"{held}; r spans {math.degrees(r_spread):.3g} deg/s, needs more than "
+                        f"{math.degrees(YAW_RATE_EXCITATION):.3g} deg/s)"
+                    )
+    checks = []
     if psi is not None:
         checks.append(("heading never changes", "psi", psi, HEADING_EXCITATION, "deg"))
     elif r is not None:
