@@ -292,8 +292,9 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         """The vector ``info`` of every sub-env: each key of the single env's info and its
         ``_key`` flags (all set)."""
         info = self.task.batch_info()
-        for key in tuple(info):
-            info[f"_{key}"] = np.ones(self.num_envs, dtype=np.bool_)
+        flags = np.ones((len(info), self.num_envs), dtype=np.bool_)  # one allocation
+        for key, flag in zip(tuple(info), flags, strict=True):
+            info[f"_{key}"] = flag
         return info
 
     def _final(self, obs: np.ndarray, done: np.ndarray) -> dict[str, Any]:
