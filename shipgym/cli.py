@@ -1185,8 +1185,12 @@ def _table(rows: Sequence[tuple[str, ...]], indent: str = "  ") -> list[str]:
     return out
 
 
-def _load_for_identify(path_text: str, fmt: str | None, note: Callable[[str], None]) -> Any:
-    """Load the record; repairs (:class:`SysidDataWarning`) and other warnings become notes."""
+def _load_for_identify(
+    path_text: str, fmt: str | None, note: Callable[[str], None], quiet: bool = False
+) -> Any:
+    """Load the record; repairs (:class:`SysidDataWarning`) and other warnings become notes.
+
+    Progress lines of a large file go to stderr unless ``quiet``."""
     import warnings
 
     from shipgym.sysid.data import FORMATS, detect_format, load
@@ -1208,7 +1212,7 @@ def _load_for_identify(path_text: str, fmt: str | None, note: Callable[[str], No
             ) from None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        record = load(path, fmt)
+        record = load(path, fmt, progress=False if quiet else None)
     messages = [str(w.message) for w in caught]
     for msg in messages:
         note(msg)
@@ -1242,7 +1246,7 @@ def _run_identify(args: argparse.Namespace) -> int:
     records, sources = [], []
     for path_text in args.path:
         say(f"loading {path_text} ...")
-        record, fmt = _load_for_identify(path_text, args.format, note)
+        record, fmt = _load_for_identify(path_text, args.format, note, args.quiet)
         chans = " ".join(k for k in record.channels() if k != "time")
         sources.append(
             f"{path_text} ({fmt}, {record.n} samples, {record.duration:g} s at dt "

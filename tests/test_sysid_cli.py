@@ -274,3 +274,18 @@ def test_plot_identification_windows_and_file(tmp_path: Path) -> None:
     assert window_lines(many) == 0
     with pytest.raises(ValueError, match="traces"):
         plot_identification(_fake_result((), None))
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_loader_progress_lines_follow_quiet(
+    records: dict[str, Path], monkeypatch: pytest.MonkeyPatch, quiet: bool
+) -> None:
+    """A file above the loader's progress threshold (lowered here) reports its loading on
+    stderr unless ``--quiet``."""
+    import shipgym.sysid.data
+
+    monkeypatch.setattr(shipgym.sysid.data, "PROGRESS_FILE_BYTES", 0)
+    argv = ["identify", str(records["clean"]), "--max-effects", "0", "--window", "none"]
+    code, _, stderr = _run(argv + ["--quiet"] * quiet)
+    assert code == 0, stderr
+    assert ("format canonical" in stderr) is not quiet, stderr
