@@ -335,7 +335,7 @@ def test_vector_autoreset_after_blow_up(env_id: str, num_envs: int) -> None:
     venv.unwrapped.task.x[blown, 3] = np.nan
     obs, rew, term, trunc, info = venv.step(actions[1])
     assert np.flatnonzero(term).tolist() == blown and not trunc.any()
-    assert [REASONS[info["reason"][i]] for i in blown] == ["numerical_blow_up"] * 2
+    assert [info["termination_reason"][i] for i in blown] == ["numerical_blow_up"] * 2
     assert np.all(rew[blown] == 0.0)
     assert np.array_equal(obs[blown], obs_before[blown]) and np.all(np.isfinite(obs))
     later = [venv.step(a) for a in actions[2:]]
