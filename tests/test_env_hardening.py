@@ -17,22 +17,20 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import pytest
+from test_envs import (  # the env ids of the env tests: one per task
+    ENV_IDS,
+    NOMOTO,
+    RVG_HEADING,
+    RVG_PATH,
+    RVG_SPEED,
+    RVG_TARGET,
+    zero_action,
+)
 
 import shipgym
 
-ENV_IDS = tuple(e for e in shipgym.ENV_IDS if e.endswith("-v0"))
-NOMOTO = "shipgym/NomotoHeading-v0"
-RVG_HEADING = "shipgym/RVGHeading-v0"
-RVG_SPEED = "shipgym/RVGSpeed-v0"
-RVG_PATH = "shipgym/RVGPathFollowing-v0"
-RVG_TARGET = "shipgym/RVGTargetTracking-v0"
-RVG_IDS = (RVG_HEADING, RVG_SPEED, RVG_PATH, RVG_TARGET)
 #: The benchmark's stress current: 1.5 times the largest ``--max-current-speed`` of the CLI.
 BENCHMARK_MAX_STRESS_CURRENT = 1.5 * 5.0
-
-
-def zero_action(env: gym.Env) -> np.ndarray:
-    return np.zeros(env.action_space.shape, dtype=np.float32)
 
 
 def rvg_state(**values: float) -> dict[str, float]:

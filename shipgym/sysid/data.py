@@ -1646,16 +1646,12 @@ def detect_format(path: str | Path) -> str:
     )
 
 
-def _progress_printer(path: Path, progress: ProgressArg) -> Callable[[str], None]:
-    """One-line progress printer: None -> stderr for files above :data:`PROGRESS_FILE_BYTES`."""
-    if progress is None:
-        try:
-            progress = path.stat().st_size > PROGRESS_FILE_BYTES
-        except OSError:
-            progress = False
+def progress_printer(progress: ProgressArg) -> Callable[[str], None]:
+    """A one-line printer from ``progress``: a callable, a text file, True (stderr), or
+    silence (False or None)."""
     if progress is True:
         progress = sys.stderr
-    if progress is False:
+    if progress is None or progress is False:
         return _silent
     if callable(progress):
         return progress
@@ -1665,6 +1661,17 @@ def _progress_printer(path: Path, progress: ProgressArg) -> Callable[[str], None
         print(msg, file=stream, flush=True)
 
     return say
+
+
+def _progress_printer(path: Path, progress: ProgressArg) -> Callable[[str], None]:
+    """:func:`progress_printer`, where None means stderr for files above
+    :data:`PROGRESS_FILE_BYTES` and silence for smaller ones."""
+    if progress is None:
+        try:
+            progress = path.stat().st_size > PROGRESS_FILE_BYTES
+        except OSError:
+            progress = False
+    return progress_printer(progress)
 
 
 def _load_with_progress(path: Path, format: str, progress: ProgressArg = None) -> Record:

@@ -36,17 +36,16 @@ import math
 import os
 import platform
 import statistics
-import sys
 import time
 import traceback
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
 import numpy as np
 
-from shipgym.sysid.data import Record, load, load_all
+from shipgym.sysid.data import ProgressArg, Record, load, load_all, progress_printer
 from shipgym.sysid.engine import IdentificationResult, identify
 from shipgym.sysid.families.base import FAMILIES
 
@@ -153,24 +152,6 @@ _ERROR_COLUMNS = (
     ("xy_rms_m", "xy RMS [m]"),
     ("u_rms_m_s", "u RMS [m/s]"),
 )
-
-ProgressArg = Callable[[str], None] | TextIO | bool | None
-
-
-def _say(progress: ProgressArg) -> Callable[[str], None]:
-    """A one-line printer from ``progress``: True -> stderr, a file, a callable, or silence."""
-    if progress is True:
-        progress = sys.stderr
-    if progress is None or progress is False:
-        return lambda _msg: None
-    if callable(progress):
-        return progress
-    stream = progress
-
-    def say(msg: str) -> None:
-        print(msg, file=stream, flush=True)
-
-    return say
 
 
 # ----------------------------------------------------------------------------------------------
@@ -357,7 +338,7 @@ def identify_all(
     models = tuple(DEFAULT_MODELS if models is None else models)
     if not models:
         raise ValueError("models must name at least one base, e.g. ('nomoto1',)")
-    say = _say(progress)
+    say = progress_printer(progress)
     if records is None:
         with warnings.catch_warnings():  # repairs are listed in meta["repairs"]
             warnings.simplefilter("ignore")
@@ -1028,7 +1009,7 @@ def benchmark_sysid(
 
     if not isinstance(repeats, int) or repeats < 1:
         raise ValueError(f"repeats must be an integer >= 1, got {repeats!r}")
-    say = _say(progress)
+    say = progress_printer(progress)
     results: list[dict[str, Any]] = []
     t_start = time.perf_counter()
 
