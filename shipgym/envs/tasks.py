@@ -516,6 +516,12 @@ class HeadingTask(ScheduleMixin, Task):
         self._set_schedule(rows, setpoints)
 
     def batch_metrics(self, rows: int | slice | np.ndarray) -> dict[str, Any]:
+        if isinstance(rows, int | np.integer):  # the single env's row, on every step: scalars
+            held = min(int(self.steps[rows]) // self.hold_steps, self.max_setpoints - 1)
+            return {
+                "heading_error": self.obs[rows, 0],
+                "heading_setpoint": self.schedule[rows, held],
+            }
         held = np.minimum(self.steps[rows] // self.hold_steps, self.max_setpoints - 1)
         # one flat take: twice as fast as 2-D fancy indexing for a large batch
         flat = np.arange(0, self.schedule.size, self.max_setpoints)[rows] + held
