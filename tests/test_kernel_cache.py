@@ -7,8 +7,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 # compiles one small kernel from the cache folder given in the environment
 _RUN = (
     "import warnings, numpy as np\n"
@@ -27,15 +25,17 @@ def _run(cache: Path) -> subprocess.CompletedProcess[str]:
     )
 
 
-@pytest.mark.parametrize("damage", ["empty", "garbled"])
-def test_unreadable_cache_entry_is_recompiled_and_replaced(tmp_path: Path, damage: str) -> None:
+def test_unreadable_cache_entry_is_recompiled_and_replaced(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
     first = _run(cache)
     assert first.returncode == 0, first.stderr
-    entries = sorted(cache.rglob("*ssa*.nb[ic]"))
-    assert entries, f"no cache entry written in {cache}"
-    for path in entries:
-        path.write_bytes(b"" if damage == "empty" else b"\x80\x04not a pickle\xff" * 7)
+    index = sorted(cache.rglob("*ssa*.nbi"))
+    data = sorted(cache.rglob("*ssa*.nbc"))
+    assert index and data, f"no cache entry written in {cache}"
+    for path in index:  # empty, as a full disk or a killed process leaves it
+        path.write_bytes(b"")
+    for path in data:  # garbled
+        path.write_bytes(b"\x80\x04not a pickle\xff" * 7)
 
     repaired = _run(cache)
     assert repaired.returncode == 0, repaired.stderr
@@ -43,6 +43,11 @@ def test_unreadable_cache_entry_is_recompiled_and_replaced(tmp_path: Path, damag
     assert "unreadable compiled-kernel cache" in repaired.stderr
     assert "recompiling" in repaired.stderr
     assert all(p.stat().st_size > 0 for p in cache.rglob("*ssa*.nb[ic]"))
+
+    for path in sorted(cache.rglob("*ssa*.nbc")):  # a garbled data file behind a good index
+        path.write_bytes(b"garbage")
+    again = _run(cache)
+    assert again.returncode == 0 and "unreadable compiled-kernel cache" in again.stderr
 
     clean = _run(cache)
     assert clean.returncode == 0, clean.stderr
