@@ -33,6 +33,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from shipgym._io import write_atomically
+
 PROG = "shipgym"
 Handler = Callable[[argparse.Namespace], int]
 Builder = Callable[["argparse._SubParsersAction[argparse.ArgumentParser]"], None]
@@ -142,7 +144,7 @@ def _run_bench(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: write_json(report, p)))
     if plot_path is not None:
         outputs.append((plot_path, lambda p: plot_ratios(report, p)))
-    _write_atomically(outputs)
+    write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}")
     return 0
@@ -458,7 +460,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: p.write_text(text)))
     if plot_path is not None:
         outputs.append((plot_path, draw))
-    _write_atomically(outputs)
+    write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}")
     return 0
@@ -589,7 +591,7 @@ def _run_evaluate(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n")))
     if plot_dir is not None:
         outputs += episode_figures(result, plot_dir, max_episodes=args.episodes)
-    _write_atomically(outputs)
+    write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}")
     return 0
@@ -781,7 +783,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
                 lambda p, env_id=env_id: plot_benchmark_trajectories(result, env_id, p),
             )
         )
-    _write_atomically(outputs)
+    write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}")
     if not args.no_throughput:
@@ -791,7 +793,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
             (out / "throughput.json", lambda p: p.write_text(json.dumps(rows, indent=2) + "\n")),
             (plots / "throughput.png", lambda p: plot_throughput(rows, p)),
         ]
-        _write_atomically(outputs)
+        write_atomically(outputs)
         for target, _ in outputs:
             print(f"wrote {target}")
     return 0
@@ -972,33 +974,6 @@ def _output_dir(text: str, flag: str) -> Path:
         raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
     _probe_directory(path if path.exists() else path.parent, flag, text)
     return path
-
-
-def _write_atomically(outputs: Sequence[tuple[Path, Callable[[Path], Any]]]) -> None:
-    """Write every ``(target, writer)`` to a temporary file next to it, then rename them all.
-
-    A failure in any writer leaves no output (and no temporary file) behind, and its message
-    names the target. A target's own directory is created (never its parents: the output
-    checks above have seen that they exist).
-    """
-    import os
-    import uuid
-
-    temps: list[tuple[Path, Path]] = []
-    try:
-        for target, write in outputs:
-            target.parent.mkdir(exist_ok=True)
-            tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex[:8]}.tmp{target.suffix}")
-            temps.append((tmp, target))
-            try:
-                write(tmp)
-            except OSError as exc:
-                raise OSError(f"cannot write {str(target)!r}: {exc.strerror or exc}") from exc
-        for tmp, target in temps:
-            os.replace(tmp, target)
-    finally:
-        for tmp, _ in temps:
-            tmp.unlink(missing_ok=True)
 
 
 def _format_value(name: str, value: Any, digits: int = 6, unit: bool = False) -> str:
@@ -1293,7 +1268,7 @@ def _run_identify(args: argparse.Namespace) -> int:
         from shipgym.sysid.plots import plot_identification
 
         outputs.append((plot_path, lambda p: plot_identification(result, p)))
-    _write_atomically(outputs)
+    write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}", file=report)
     if args.json == "-":

@@ -28,6 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
 import shipgym  # noqa: F401  (registers the environments)
+from shipgym._io import write_atomically
 from shipgym.benchmark.policies import RVGPathClassic
 from shipgym.maneuvers import plot_zigzag, zigzag
 from shipgym.models import NOMOTO_MODEL_NAMES
@@ -339,9 +340,11 @@ def run_demo(out_dir: str | Path = "shipgym-demo", model: str = "nomoto1") -> di
     except OSError as exc:
         raise ValueError(f"cannot create output directory {str(out)!r}: {exc.strerror}") from None
     zz = zigzag(model, a_deg=20.0)
-    zz_png = plot_zigzag(zz, out / "zigzag.png")
     ep = path_following_episode()
-    pf_png = plot_path_following(ep, out / "path_following.png")
+    zz_png, pf_png = out / "zigzag.png", out / "path_following.png"
+    write_atomically(
+        [(zz_png, lambda p: plot_zigzag(zz, p)), (pf_png, lambda p: plot_path_following(ep, p))]
+    )
     return {
         "model": model,
         "zigzag_png": str(zz_png),

@@ -29,6 +29,7 @@ def test_demo_writes_figures_and_plausible_summary(tmp_path: Path, capsys) -> No
     assert _is_png(out / "zigzag.png")
     assert _is_png(out / "path_following.png")
     assert str(out / "zigzag.png") in stdout and str(out / "path_following.png") in stdout
+    assert sorted(p.name for p in out.iterdir()) == ["path_following.png", "zigzag.png"]
 
     first, second = (
         float(v)
@@ -233,7 +234,7 @@ def test_simulate_writes_both_outputs_and_no_temporary_file(tmp_path: Path, caps
 
 
 def test_a_failed_write_leaves_no_output_and_names_the_target(tmp_path: Path) -> None:
-    from shipgym.cli import _write_atomically
+    from shipgym._io import write_atomically
 
     def fail(path: Path) -> None:
         path.write_text("half")
@@ -241,5 +242,5 @@ def test_a_failed_write_leaves_no_output_and_names_the_target(tmp_path: Path) ->
 
     first, second = tmp_path / "a.json", tmp_path / "b.png"
     with pytest.raises(OSError, match=r"cannot write '.*b\.png': No space left on device"):
-        _write_atomically([(first, lambda p: p.write_text("{}")), (second, fail)])
+        write_atomically([(first, lambda p: p.write_text("{}")), (second, fail)])
     assert list(tmp_path.iterdir()) == []
