@@ -270,7 +270,7 @@ def test_rvg_refuses_a_five_second_step_naming_the_stable_step() -> None:
     x, u = _cruise("rvg3dof")
     message = (
         r"dt=5 s is beyond the stable RK4 step of model 'rvg3dof' "
-        r"\(about 2.79 s at this state\); use dt <= 2.78"
+        r"\(about 2.79 s\); use dt <= 2.78"
     )
     with pytest.raises(ValueError, match=message):
         model.simulate(x, np.tile(u, (20, 1)), 5.0)
@@ -286,7 +286,7 @@ def test_norrbin_refuses_a_fifty_second_step_naming_the_stable_step() -> None:
     u[0] = 0.3
     message = (
         r"dt=50 s is beyond the stable RK4 step of model 'norrbin' "
-        r"\(about 5.57 s at this state\); use dt <= 5.57"
+        r"\(about 5.57 s\); use dt <= 5.57"
     )
     with pytest.raises(ValueError, match=message):
         model.simulate(x, np.tile(u, (50, 1)), 50.0)
