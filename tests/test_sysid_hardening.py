@@ -278,6 +278,21 @@ def test_held_rudder_refused_in_a_steady_turn_but_not_in_a_step_response() -> No
     assert fit.values["T"] == pytest.approx(30.0, rel=0.05)
 
 
+def test_runs_whose_rudder_never_moves_for_different_reasons_are_refused_together() -> None:
+    """One run with the rudder at zero, one holding it in a steady turn: in neither does the
+    rudder move, so together they identify nothing either."""
+    t = 0.5 * np.arange(801)
+    rng = np.random.default_rng(5)
+    turning = np.cumsum(np.full(t.size, 0.005)) + 0.3 * np.sin(t / 50.0)
+    still = Record(time=t, delta=np.zeros(t.size), psi=turning, r=np.gradient(turning, t))
+    steady = Record(
+        time=t, delta=np.full(t.size, 0.2), psi=0.01 * t,
+        r=0.01 + 1e-5 * rng.standard_normal(t.size),
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"the rudder moves in none of the 2 runs"):
+        identify([still, steady], "vmm:martin_simple", max_effects=0)
+
+
 def test_every_family_refuses_a_record_without_excitation() -> None:
     rec = _without("all")
     for model in ("nomoto2", "rvg3dof"):

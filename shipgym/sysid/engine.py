@@ -36,7 +36,7 @@ import numpy as np
 
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import Candidate, ModelFamily, get_family, jsonable
-from shipgym.sysid.fit import excitation_problems
+from shipgym.sysid.fit import excitation_problems, no_excitation_error
 
 __all__ = ["IdentificationResult", "identify"]
 
@@ -148,18 +148,14 @@ def _check_excitation(runs: Sequence[Record]) -> None:
     manoeuvres is fine).
     """
     per_run = [excitation_problems(rec.delta, rec.psi, rec.r) for rec in runs]
-    kinds = [{p.split(" (")[0] for p in problems} for problems in per_run]
-    common = set.intersection(*kinds)
+    common = set.intersection(*({kind for kind, _ in problems} for problems in per_run))
     if not common:
         return
-    problems = [p for p in per_run[0] if p.split(" (")[0] in common]
-    if len(runs) > 1:
-        problems = [f"{p} in any of the {len(runs)} runs" for p in sorted(common)]
-    raise ValueError(
-        "not identifiable: no excitation: "
-        + " and ".join(problems)
-        + "; expected a manoeuvre that moves the rudder and turns the ship (zigzag, turning"
-        " circle, pull-out or random rudder)"
+    if len(runs) == 1:
+        raise no_excitation_error([text for kind, text in per_run[0] if kind in common])
+    words = {"rudder": "the rudder moves", "turn": "the ship turns"}
+    raise no_excitation_error(
+        [f"{words[kind]} in none of the {len(runs)} runs" for kind in sorted(common)]
     )
 
 

@@ -66,7 +66,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -101,6 +101,7 @@ __all__ = [
     "excitation_problems",
     "fit_equation_error",
     "fit_output_error",
+    "no_excitation_error",
     "regression_data",
     "regression_to_params",
     "replay",
@@ -172,7 +173,7 @@ def _spread_and_noise(a: np.ndarray) -> tuple[float, float]:
 
 def excitation_problems(
     delta: npt.ArrayLike, psi: npt.ArrayLike | None = None, r: npt.ArrayLike | None = None
-) -> list[str]:
+) -> list[tuple[str, str]]:
     """What is missing for a yaw model to be identifiable from a record (empty: nothing).
 
     The rudder must move (spread above :data:`RUDDER_EXCITATION` and above 6 times its noise;
@@ -192,8 +193,10 @@ def excitation_problems(
 
     Returns
     -------
-    list of str
-        One phrase per missing excitation, e.g. ``"the rudder never moves (...)"``.
+    list of (str, str)
+        One ``(kind, phrase)`` per missing excitation: kind ``"rudder"`` (the rudder never
+        moves, or is held in a steady turn) or ``"turn"`` (the heading, or the yaw rate,
+        never changes), and a phrase such as ``"the rudder never moves (...)"``.
     """
     out = []
     d = np.asarray(delta, dtype=np.float64)
@@ -209,14 +212,17 @@ def excitation_problems(
                 + (f" and 6 times its noise {math.degrees(noise):.3g} deg" if noise else "")
             )
             if abs(level) <= limit:  # no input at all
-                out.append(f"the rudder never moves ({held})")
+                out.append(("rudder", f"the rudder never moves ({held})"))
             elif r is not None:  # a held rudder identifies the model only through a transient
                 r_spread, r_noise = _spread_and_noise(np.asarray(r, dtype=np.float64))
                 if not r_spread > max(YAW_RATE_EXCITATION, 6.0 * r_noise):
                     out.append(
-                        f"the rudder never moves and the yaw rate never changes (a steady turn: "
-                        f"{held}; r spans {math.degrees(r_spread):.3g} deg/s, needs more than "
-                        f"{math.degrees(YAW_RATE_EXCITATION):.3g} deg/s)"
+                        (
+                            "rudder",
+                            f"the rudder never moves and the yaw rate never changes (a steady "
+                            f"turn: {held}; r spans {math.degrees(r_spread):.3g} deg/s, needs "
+                            f"more than {math.degrees(YAW_RATE_EXCITATION):.3g} deg/s)",
+                        )
                     )
     checks = []
     if psi is not None:
@@ -229,12 +235,13 @@ def excitation_problems(
             continue
         spread, noise = _spread_and_noise(arr)
         if not spread > max(floor, 6.0 * noise):
-            out.append(
+            text = (
                 f"the {what} ({name} spans {math.degrees(spread):.3g} {unit} between its 1st and"
                 f" 99th percentiles; needs more than {math.degrees(floor):.3g} {unit}"
                 + (f" and 6 times its noise {math.degrees(noise):.3g} {unit}" if noise else "")
                 + ")"
             )
+            out.append(("turn", text))
     return out
 
 
@@ -251,12 +258,20 @@ def check_excitation(
     """
     problems = excitation_problems(delta, psi, r)
     if problems:
-        raise ValueError(
-            "not identifiable: no excitation: "
-            + " and ".join(problems)
-            + "; expected a manoeuvre that moves the rudder and turns the ship (zigzag, turning"
-            " circle, pull-out or random rudder)"
-        )
+        raise no_excitation_error([text for _, text in problems])
+
+
+_check_excitation = check_excitation  # for functions with a ``check_excitation`` flag
+
+
+def no_excitation_error(problems: Sequence[str]) -> ValueError:
+    """The error for a record without excitation, naming each of ``problems``."""
+    return ValueError(
+        "not identifiable: no excitation: "
+        + " and ".join(problems)
+        + "; expected a manoeuvre that moves the rudder and turns the ship (zigzag, turning"
+        " circle, pull-out or random rudder)"
+    )
 
 
 def _check_model(model: str) -> str:
@@ -749,7 +764,8 @@ def fit_equation_error(
     model : {"nomoto1", "nomoto2", "norrbin", "bech"}
         Model to fit.
     psi : array_like, optional
-        Heading [rad]; only used to report the simulation RMS (``rms_psi`` is NaN without it).
+        Heading [rad]: used to report the simulation RMS (``rms_psi`` is NaN without it) and
+        to refuse a record whose heading never changes.
     U : array_like or float, optional
         Speed [m/s] for the replay (positions only).
     bias : bool
@@ -995,6 +1011,7 @@ def fit_output_error(
     gear: SteeringGear | None = None,
     surge: SurgeModel | None = None,
     max_nfev: int | None = None,
+    check_excitation: bool = True,
 ) -> FitResult:
     """Output-error (simulation-error) fit of a yaw model that also estimates the initial state.
 
@@ -1034,6 +1051,9 @@ def fit_output_error(
         Actuators of the returned model.
     max_nfev : int, optional
         Budget of :func:`scipy.optimize.least_squares`.
+    check_excitation : bool
+        Refuse a record without excitation first (:func:`check_excitation`). Searches that
+        fit many candidates to one record, already checked, pass False.
 
     Returns
     -------
@@ -1051,7 +1071,8 @@ def fit_output_error(
     delta = _as_1d("delta", delta, n)
     psi = _as_1d("psi", psi, n)
     r = _as_1d("r", r, n)
-    check_excitation(delta, psi, r)
+    if check_excitation:
+        _check_excitation(delta, psi, r)
     speed = _speed(U, t)
     cls = _PARAM_CLASS[model]
     if init is not None and not isinstance(init, cls):

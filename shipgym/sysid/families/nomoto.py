@@ -472,7 +472,8 @@ def _fit_config(
             warnings.simplefilter("ignore", RuntimeWarning)
             d_in = _input(cfg, t, delta, T_d, tau, y0)[sl]
             seg = (t[sl], d_in, psi[sl], r[sl])
-            kw = {**kw, "U": U_full[sl]}
+            # the record's excitation was checked once by identify, not again per candidate
+            kw = {**kw, "U": U_full[sl], "check_excitation": False}
             if warm is not None:
                 return fit_output_error(
                     *seg,
