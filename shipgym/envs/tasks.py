@@ -7,9 +7,10 @@ the initial conditions with NumPy, for all rows being reset at once. The single 
 a batch of one, so the vector environment's sub-env ``i`` seeded with ``s + i`` reproduces the
 single environment seeded with ``s`` exactly, and autoresets of many sub-envs cost one pass.
 
-Current in ``reset(options=...)``: ``current_speed`` [m/s, >= 0] and ``current_direction``
-[rad, the direction the water moves toward, clockwise from north]. Without them the speed is
-drawn uniformly from ``[0, max_current_speed]`` and the direction uniformly from [-pi, pi).
+Current in ``reset(options=...)``: ``current_speed`` [m/s, 0 to the ship's top speed] and
+``current_direction`` [rad, the direction the water moves toward, clockwise from north].
+Without them the speed is drawn uniformly from ``[0, max_current_speed]`` and the direction
+uniformly from [-pi, pi).
 
 Every reset option has a physical range, and a value outside it raises ``ValueError`` naming
 the option, the value and the range (nothing changes then). The ranges come from the ship and
@@ -319,18 +320,15 @@ class Task:
             draws[k] = rng.random(self.n_draws)
         speed = draws[:, 0] * self.max_current_speed
         direction = _uniform(draws[:, 1], -math.pi, math.pi)
+        self._validate_task_options(options)  # every option, before anything is changed
         if "current_speed" in options:
-            s = _finite_float("current_speed", options["current_speed"])
-            if s < 0:
-                raise ValueError(f"option 'current_speed' must be >= 0 m/s, got {s!r}")
-            speed[:] = s
+            speed[:] = float(options["current_speed"])
         if "current_direction" in options:
-            direction[:] = _finite_float("current_direction", options["current_direction"])
+            direction[:] = float(options["current_direction"])
         task_draws = draws[:, _N_COMMON_DRAWS:]
         states = self._initial_states(task_draws)
         if "initial_state" in options:
             self._apply_initial_state(options["initial_state"], states)
-        self._validate_task_options(options)
         self.current[rows, 0] = speed
         self.current[rows, 1] = direction
         self.c[rows, 0] = speed * np.cos(direction)
@@ -471,10 +469,6 @@ class ScheduleMixin:
         k = setpoints.shape[1]
         self.schedule[rows] = setpoints[:, -1:]
         self.schedule[rows, :k] = setpoints
-
-    def current_setpoint(self, i: int, steps: int) -> float:
-        """Setpoint of row ``i`` after ``steps`` steps."""
-        return float(self.schedule[i, min(steps // self.hold_steps, self.max_setpoints - 1)])
 
 
 class HeadingTask(ScheduleMixin, Task):
