@@ -49,7 +49,7 @@ def real_array(value: Any, name: str) -> np.ndarray:
         except (TypeError, ValueError, OverflowError):
             pass
     raise TypeError(
-        f"{name} must be an array of real numbers, got dtype {arr.dtype} ({_short(value)})"
+        f"{name} must be an array of real numbers, got dtype {arr.dtype} ({short_repr(value)})"
     )
 
 
@@ -82,7 +82,7 @@ def step_size(dt: Any, name: str = "dt") -> float:
     if isinstance(dt, np.ndarray) and dt.ndim == 0 and dt.dtype.kind in _REAL_KINDS:
         dt = dt.item()
     if isinstance(dt, bool | np.bool_) or not isinstance(dt, numbers.Real):
-        raise TypeError(f"{name} must be a real number of seconds, got {_short(dt)}")
+        raise TypeError(f"{name} must be a real number of seconds, got {short_repr(dt)}")
     h = float(dt)
     if not (math.isfinite(h) and h > 0.0):
         raise ValueError(f"{name} must be a finite step > 0 s, got {h!r}")
@@ -92,7 +92,7 @@ def step_size(dt: Any, name: str = "dt") -> float:
 def positive_number(value: Any, name: str) -> float:
     """A real, finite number > 0 as a float (``TypeError`` / ``ValueError`` otherwise)."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {_short(value)}")
+        raise TypeError(f"{name} must be a real number, got {short_repr(value)}")
     v = float(value)
     if not (math.isfinite(v) and v > 0.0):
         raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
@@ -102,7 +102,7 @@ def positive_number(value: Any, name: str) -> float:
 def count(value: Any, name: str, minimum: int, maximum: int) -> int:
     """An integer in ``[minimum, maximum]`` (``TypeError`` for a non-integer)."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer, got {_short(value)}")
+        raise TypeError(f"{name} must be an integer, got {short_repr(value)}")
     n = int(value)
     if not minimum <= n <= maximum:
         raise ValueError(f"{name} must be an integer in [{minimum}, {maximum}], got {n}")
@@ -114,6 +114,7 @@ def shape_error(name: str, expected: str, got: tuple[int, ...], hint: str = "") 
     return ValueError(f"{name} must have shape {expected}{hint}, got {got}")
 
 
-def _short(value: Any) -> str:
+def short_repr(value: Any) -> str:
+    """``repr(value)``, cut to 60 characters for an error message."""
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."

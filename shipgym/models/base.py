@@ -1,13 +1,13 @@
 """Ship models as objects: a name, parameters, state/input names and the shared kernels.
 
-A :class:`ShipModel` couples one derivative kernel (``shipgym.models.integrate.rhs``) with
+A :class:`ShipModel` couples one derivative kernel (``shipgym.models.integrate.rhs_kernel``) with
 its packed parameters, and offers the batched derivative, one RK4 step and whole-trajectory
 simulation as a :class:`SimulationResult` (time, states and inputs with names, like a
 python-control response object).
 
 Every method checks its arguments in Python before a compiled kernel sees them (the kernels do
 no bounds checking): shapes against the model's states and inputs, real numbers (``TypeError``
-otherwise), finite values, a finite step > 0 and a step RK4 can take at the state (``ValueError``
+otherwise), finite values, a finite step > 0 within the model's stable RK4 step (``ValueError``
 naming the argument, what it was and what was expected). See :class:`ShipModel`, "Checks".
 """
 
@@ -29,6 +29,7 @@ from shipgym.models._checks import (
     real_array,
     require_finite,
     shape_error,
+    short_repr,
     step_size,
 )
 from shipgym.models.current import Current
@@ -87,11 +88,6 @@ class SimulationResult:
 
 MAX_STEPS = 100_000_000
 """Most steps one :meth:`ShipModel.simulate` call takes (its result alone would be gigabytes)."""
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _round_down(value: float) -> float:
@@ -290,8 +286,8 @@ class ShipModel:
         if not np.isfinite(out).all():
             i = int(np.argwhere(~np.isfinite(out))[0, 0])
             raise ValueError(
-                f"the derivative is not finite at row {i}: state {_short(xb[i].tolist())}, "
-                f"input {_short(ub[i].tolist())} are beyond what model {self.name!r} can "
+                f"the derivative is not finite at row {i}: state {short_repr(xb[i].tolist())}, "
+                f"input {short_repr(ub[i].tolist())} are beyond what model {self.name!r} can "
                 "evaluate"
             )
         return out
@@ -356,8 +352,9 @@ class ShipModel:
             jac = self._jacobians(x, u, c, eps, inputs=True)[0]
         if not np.isfinite(jac).all():
             raise ValueError(
-                f"the Jacobian of model {self.name!r} is not finite at x0={_short(x[0].tolist())},"
-                f" u0={_short(u[0].tolist())}: the state or input is beyond what it can evaluate"
+                f"the Jacobian of model {self.name!r} is not finite at "
+                f"x0={short_repr(x[0].tolist())}, u0={short_repr(u[0].tolist())}: the state or "
+                "input is beyond what it can evaluate"
             )
         return jac[:, : self.nx], jac[:, self.nx :]
 
@@ -419,8 +416,8 @@ class ShipModel:
         if dt > limit:
             return ValueError(f"{message}: {self._beyond(dt, limit)}")
         return ValueError(
-            f"{message}: the state before it, {_short(x.tolist())}, with input "
-            f"{_short(u.tolist())} is beyond what the model can evaluate"
+            f"{message}: the state before it, {short_repr(x.tolist())}, with input "
+            f"{short_repr(u.tolist())} is beyond what the model can evaluate"
         )
 
     # ---------------------------------------------------------------------------------------
@@ -474,7 +471,7 @@ class ShipModel:
             raise ValueError(
                 f"the policy must return an array of shape ({self.nu},) {self.input_names} of "
                 f"finite numbers; at t={t:g} s it returned {type(value).__name__} "
-                f"{_short(value)}{got}"
+                f"{short_repr(value)}{got}"
             )
         return arr.reshape(self.nu)
 
@@ -573,7 +570,7 @@ def _check_actuators(gear: Any, surge: Any, required: bool) -> None:
     """``TypeError`` for a steering gear or surge model of the wrong type."""
     for value, cls, label in ((gear, SteeringGear, "gear"), (surge, SurgeModel, "surge")):
         if (value is not None or required) and not isinstance(value, cls):
-            raise TypeError(f"{label} must be a {cls.__name__}, got {_short(value)}")
+            raise TypeError(f"{label} must be a {cls.__name__}, got {short_repr(value)}")
 
 
 _DEFAULT_YAW = {
@@ -618,7 +615,7 @@ def make_model(
         For an unknown name or parameters of the wrong type.
     """
     if not isinstance(name, str):
-        raise TypeError(f"model name must be a str, one of {MODEL_NAMES}, got {_short(name)}")
+        raise TypeError(f"model name must be a str, one of {MODEL_NAMES}, got {short_repr(name)}")
     if name not in MODEL_NAMES:
         raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
     _check_actuators(gear, surge, required=False)

@@ -5,7 +5,9 @@
 ``(n, nu)``, ``c`` the ``(n, 2)`` north/east current) by calling the model's per-ship kernel.
 ``rk4_step`` advances the batch in place by one classic fourth-order Runge-Kutta step with
 the input and current held over the step (seed 001 eq. 2). Every user of a model, the
-environments, the manoeuvres and identification, integrates through these functions.
+environments, the manoeuvres and identification, integrates through their compiled kernels
+(``rhs_kernel``, ``rk4_step_kernel``, ``rk4_row``); ``rhs`` and ``rk4_step`` are the same
+kernels behind argument checks, for calls from Python.
 
 Both run ship by ship through ``rk4_stages``, whose four stages use small work vectors that
 stay in the CPU cache; the environments' kernels call ``rk4_row`` (the same stages over the
@@ -252,7 +254,8 @@ def rk4_step(model_id: int, x: np.ndarray, u: Any, p: Any, c: Any, h: float) -> 
 
     The arguments are those of :func:`rhs` (``x`` a writable float64 ``(n, nx)`` array in C
     order, updated in place); ``h`` is a finite step > 0 s. The step is not checked against
-    :func:`rk4_stable_step` here (:meth:`shipgym.models.ShipModel.step` does that).
+    the model's stable step here (:meth:`shipgym.models.ShipModel.step` checks it against the
+    stable step at rest, :meth:`~shipgym.models.ShipModel.stable_step`).
 
     Raises
     ------
