@@ -157,6 +157,8 @@ def test_current_and_angle_helpers_refuse_bad_arrays() -> None:
         current_ned(np.array([1j]), 0.0)
     with pytest.raises(ValueError, match=r"Current\.as_batch: n must be an integer >= 0"):
         Current(1.0, 0.0).as_batch(-1)
+    with pytest.raises(ValueError, match=r"Current\.as_batch: n must be at most 1e\+09"):
+        Current(1.0, 0.0).as_batch(2**63)  # no OverflowError from NumPy
     with pytest.raises(ValueError, match="angle must not be infinite"):
         ssa(np.array([0.0, math.inf]))
     with pytest.raises(TypeError, match="real numbers"):

@@ -72,7 +72,8 @@ _ELEMENTS = {
     "int64": st.integers(-(2**40), 2**40),
     "bool": st.booleans(),
     "complex128": st.complex_numbers(max_magnitude=1e3),
-    "<U3": st.text(max_size=3),
+    # NumPy strings cannot hold a trailing NUL: leave it out of the alphabet
+    "<U3": st.text(st.characters(exclude_characters="\x00"), max_size=3),
     "object": _OBJECTS,
 }
 

@@ -81,21 +81,22 @@ def step_size(dt: Any, name: str = "dt") -> float:
         return dt
     if isinstance(dt, np.ndarray) and dt.ndim == 0 and dt.dtype.kind in _REAL_KINDS:
         dt = dt.item()
-    if isinstance(dt, bool | np.bool_) or not isinstance(dt, numbers.Real):
-        raise TypeError(f"{name} must be a real number of seconds, got {short_repr(dt)}")
-    h = float(dt)
-    if not (math.isfinite(h) and h > 0.0):
-        raise ValueError(f"{name} must be a finite step > 0 s, got {h!r}")
-    return h
+    return positive_number(dt, name, "a real number of seconds", "a finite step > 0 s")
 
 
-def positive_number(value: Any, name: str) -> float:
-    """A real, finite number > 0 as a float (``TypeError`` / ``ValueError`` otherwise)."""
+def positive_number(
+    value: Any,
+    name: str,
+    kind: str = "a real number",
+    expected: str = "a finite number > 0",
+) -> float:
+    """A real, finite number > 0 as a float: ``TypeError`` ``"<name> must be <kind>"``
+    otherwise, ``ValueError`` ``"<name> must be <expected>"`` for NaN, inf, zero or less."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        raise TypeError(f"{name} must be a real number, got {short_repr(value)}")
+        raise TypeError(f"{name} must be {kind}, got {short_repr(value)}")
     v = float(value)
     if not (math.isfinite(v) and v > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        raise ValueError(f"{name} must be {expected}, got {v!r}")
     return v
 
 

@@ -17,6 +17,9 @@ import numpy as np
 
 from shipgym.models._checks import real_array
 
+_MAX_ROWS = 10**9
+"""Most rows :meth:`Current.as_batch` makes (16 GB; more would not fit in memory)."""
+
 
 @dataclass(frozen=True)
 class Current:
@@ -50,6 +53,8 @@ class Current:
         """The current as the ``(n, 2)`` north/east array that model kernels take."""
         if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
             raise ValueError(f"Current.as_batch: n must be an integer >= 0, got {n!r}")
+        if n > _MAX_ROWS:
+            raise ValueError(f"Current.as_batch: n must be at most {_MAX_ROWS:.0e}, got {n}")
         return np.tile(np.array(self.ned, dtype=np.float64), (n, 1))
 
 
