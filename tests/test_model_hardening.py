@@ -168,6 +168,8 @@ def test_current_and_angle_helpers_refuse_bad_arrays() -> None:
         propeller_loading(np.array([1.0, math.nan]), 1.0, 1000.0)
     with pytest.raises(ValueError, match="diameter must be a finite number > 0"):
         propeller_loading(np.ones(2), -1.0, 1000.0)
+    with pytest.raises(ValueError, match=r"too large\) must be finite"):
+        propeller_loading(np.ones(2), 1e300, 1025.0)  # D^4 overflows: ValueError, no OverflowError
 
 
 # --------------------------------------------------------------------------------------------

@@ -186,7 +186,7 @@ def propeller_loading(rps: np.ndarray, diameter: float, rho: float) -> np.ndarra
     diameter = positive_number(diameter, "diameter")
     rho = positive_number(rho, "rho")
     with np.errstate(over="ignore"):
-        loading = rho * diameter**4 * n * np.abs(n)
+        loading = rho * np.float64(diameter) ** 4 * n * np.abs(n)  # inf, never OverflowError
     require_finite(loading, "propeller loading rho D^4 n |n| (too large)")
     return loading
 
