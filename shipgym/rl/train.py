@@ -16,13 +16,11 @@ was trained or selected on.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import platform
-import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from shipgym.envs import env_task
+from shipgym.rl import checkpoints
 
 ALGOS = ("ppo", "sac")
 #: First seed of the evaluation callback's validation episodes.
@@ -140,12 +139,272 @@ def _obs_normaliser(vec_normalize: Any) -> dict[str, Any]:
     }
 
 
-def _atomic_write_text(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.chmod(tmp, 0o644)  # mkstemp makes it private; the record is a plain package file
-    os.replace(tmp, path)
+def tensorboard_logger(folder: Path | None, verbose: int = 0) -> Any:
+    """An SB3 logger that writes TensorBoard events into ``folder`` (and stdout if verbose).
+
+    ``folder`` None gives :func:`console_logger`. Several event files in one folder (a run
+    resumed after an interrupt) show as one run in TensorBoard, the steps continuing.
+    """
+    import sys
+
+    from stable_baselines3.common.logger import HumanOutputFormat, Logger, TensorBoardOutputFormat
+
+    if folder is None:
+        return console_logger(verbose)
+    folder.mkdir(parents=True, exist_ok=True)
+    formats: list[Any] = [TensorBoardOutputFormat(str(folder))]
+    if verbose:
+        formats.append(HumanOutputFormat(sys.stdout))
+    return Logger(folder=str(folder), output_formats=formats)
+
+
+def _next_tensorboard_run(root: Path, name: str) -> str:
+    """``<name>_<k>`` with ``k`` one more than the runs of ``name`` already in ``root`` (SB3's
+    naming: a new training into the same folder is a new run in TensorBoard)."""
+    taken = [0]
+    if root.is_dir():
+        for child in root.iterdir():
+            head, _, tail = child.name.rpartition("_")
+            if head == name and tail.isdigit():
+                taken.append(int(tail))
+    return f"{name}_{max(taken) + 1}"
+
+
+def _tensorboard_root(out: Path, tensorboard_log: str | Path | bool) -> Path | None:
+    if tensorboard_log is False:
+        return None
+    if tensorboard_log is True:
+        return out / checkpoints.TENSORBOARD
+    return Path(tensorboard_log)
+
+
+def _versions() -> dict[str, str]:
+    import stable_baselines3
+    import torch
+
+    return {
+        "python": platform.python_version(),
+        "stable_baselines3": stable_baselines3.__version__,
+        "torch": torch.__version__,
+        "numpy": np.__version__,
+    }
+
+
+class _Run:
+    """One training session: the model, its envs, the record so far and the checkpoints.
+
+    A fresh training and a resumed one differ only in how the model, the normaliser and the
+    record are made; evaluating, checkpointing and finishing are this class.
+    """
+
+    def __init__(
+        self,
+        out: Path,
+        record: dict[str, Any],
+        model: Any,
+        venv: Any,
+        eval_env: Any,
+        tb_root: Path | None,
+        progress: Callable[[str], None] | None,
+        on_evaluation: Callable[[dict[str, Any]], None] | None,
+        verbose: int,
+        best: dict[str, Any] | None = None,
+    ) -> None:
+        self.out = out
+        self.record = record
+        self.name = record["name"]
+        self.algo = record["algo"]
+        self.model = model
+        self.venv = venv
+        self.eval_env = eval_env
+        self.progress = progress
+        self.on_evaluation = on_evaluation
+        self.best: dict[str, Any] = dict(best or {})
+        self.tb_folder = None if tb_root is None else tb_root / record["tensorboard_run"]
+        self.logger = tensorboard_logger(self.tb_folder, verbose)
+        model.set_logger(self.logger)
+        self.wall_before = float(record.get("wall_time_s", 0.0))
+        self.steps_at_start = int(model.num_timesteps)
+        self.start = time.perf_counter()
+        curve = record["learning_curve"]
+        self.next_eval = self._after(curve["timesteps"][-1] if curve["timesteps"] else 0)
+
+    def _after(self, step: int) -> int:
+        freq = int(self.record["eval_freq"])
+        return (step // freq + 1) * freq
+
+    def wall(self) -> float:
+        return self.wall_before + time.perf_counter() - self.start
+
+    def snapshot(self, partial: bool, obs_normaliser: dict[str, Any]) -> dict[str, Any]:
+        """The record as of now (``partial`` until the requested steps are done)."""
+        steps = int(self.model.num_timesteps)
+        wall = self.wall()
+        curve = self.record["learning_curve"]
+        return {
+            **self.record,
+            "timesteps": steps,
+            "partial": partial,
+            "wall_time_s": round(wall, 2),
+            "steps_per_s": round(steps / max(wall, 1e-9), 1),
+            "best_timestep": self.best.get("timestep"),
+            "best_validation_return": self.best.get("reward"),
+            "final_validation_return": curve["mean_return"][-1] if curve["mean_return"] else None,
+            "obs_normaliser": obs_normaliser,
+        }
+
+    def evaluate(self, final: bool = False) -> None:
+        """Score the deterministic policy on the validation episodes; checkpoint best/latest."""
+        from stable_baselines3.common.evaluation import evaluate_policy
+        from stable_baselines3.common.vec_env import sync_envs_normalization
+
+        step = int(self.model.num_timesteps)
+        curve = self.record["learning_curve"]
+        if curve["timesteps"] and curve["timesteps"][-1] == step and not final:
+            return
+        evaluated = not (curve["timesteps"] and curve["timesteps"][-1] == step)
+        if evaluated:
+            sync_envs_normalization(self.venv, self.eval_env)
+            returns, lengths = evaluate_policy(
+                self.model,
+                self.eval_env,
+                n_eval_episodes=int(self.record["validation_seeds"][1])
+                - int(self.record["validation_seeds"][0])
+                + 1,
+                deterministic=True,
+                return_episode_rewards=True,
+            )
+            mean = float(np.mean(returns))
+            curve["timesteps"].append(step)
+            curve["mean_return"].append(mean)
+            curve["std_return"].append(float(np.std(returns)))
+            self.logger.record("eval/mean_reward", mean)
+            self.logger.record("eval/mean_ep_length", float(np.mean(lengths)))
+            self.logger.dump(step)
+            obs = _obs_normaliser(self.venv)
+            if not all(math.isfinite(v) for v in obs["mean"]):
+                raise RuntimeError(f"{self.name}: the observation normaliser is not finite")
+            if "reward" not in self.best or mean > self.best["reward"]:
+                self.best = {"obs": obs, "timestep": step, "reward": mean}
+                checkpoints.write_best(
+                    self.out, self.name, self.model, self.venv, self.snapshot(not final, obs)
+                )
+        obs = _obs_normaliser(self.venv)
+        checkpoints.write_latest(
+            self.out,
+            self.name,
+            self.model,
+            self.venv,
+            self.snapshot(not final, obs),
+            replay_buffer=self.record["checkpoint_replay_buffer"],
+        )
+        self.next_eval = self._after(step)
+        mean = curve["mean_return"][-1]
+        if self.progress is not None and evaluated:
+            total = int(self.record["requested_timesteps"])
+            rate = (step - self.steps_at_start) / max(time.perf_counter() - self.start, 1e-9)
+            self.progress(
+                f"{self.name}: {step}/{total} steps ({100 * step / total:.0f} %, "
+                f"{rate:.0f} steps/s), validation return {mean:.1f}, "
+                f"best {self.best['reward']:.1f}"
+            )
+        if self.on_evaluation is not None:
+            self.on_evaluation(
+                {
+                    "timesteps": step,
+                    "validation_return": mean,
+                    "best_validation_return": self.best["reward"],
+                    "best_timestep": self.best["timestep"],
+                    "final": final,
+                }
+            )
+
+    def callback(self) -> Any:
+        """The SB3 callback that evaluates every ``eval_freq`` environment steps."""
+        from stable_baselines3.common.callbacks import BaseCallback
+
+        run = self
+
+        class _Evaluations(BaseCallback):
+            def _on_step(self) -> bool:
+                if self.num_timesteps >= run.next_eval:
+                    run.evaluate()
+                return True
+
+        return _Evaluations()
+
+    def learn(self, callbacks: Sequence[Any], progress_bar: bool, fresh: bool) -> TrainResult:
+        """Train to the requested steps, evaluate a last time and write the final record."""
+        from stable_baselines3.common.callbacks import CallbackList
+
+        total = int(self.record["requested_timesteps"])
+        try:
+            self.model.learn(
+                total - self.steps_at_start,
+                callback=CallbackList([self.callback(), *callbacks]),
+                progress_bar=progress_bar,
+                reset_num_timesteps=fresh,
+            )
+            # a final evaluation (unless one fell on the last step), so the end can win too
+            self.evaluate(final=True)
+        finally:
+            self.logger.close()
+            self.venv.close()
+            self.eval_env.close()
+        meta = self.snapshot(False, self.best["obs"])
+        checkpoints.write_final_record(self.out, self.name, meta)
+        return TrainResult(
+            model_path=self.out / f"{self.name}.zip",
+            meta_path=self.out / f"{self.name}.json",
+            meta=meta,
+        )
+
+
+def _make_envs(
+    env_id: str,
+    num_envs: int,
+    seed: int,
+    eval_episodes: int,
+    env_kwargs: dict[str, Any],
+    norm_reward: bool,
+    gamma: float,
+    vecnormalize_path: Path | None = None,
+) -> tuple[Any, Any]:
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    from shipgym.rl.vec_env import ShipgymVecEnv
+
+    inner = VecMonitor(ShipgymVecEnv(env_id, num_envs, **env_kwargs))
+    if vecnormalize_path is None:
+        venv = VecNormalize(inner, norm_obs=True, norm_reward=norm_reward, gamma=gamma)
+    else:
+        venv = VecNormalize.load(str(vecnormalize_path), inner)
+        venv.training = True
+    venv.seed(seed)
+    eval_env = VecNormalize(
+        VecMonitor(ShipgymVecEnv(env_id, eval_episodes, fixed_seed=VALIDATION_SEED, **env_kwargs)),
+        training=False,
+        norm_obs=True,
+        norm_reward=False,
+    )
+    return venv, eval_env
+
+
+def _check_fresh_folder(out: Path, name: str, overwrite: bool) -> None:
+    """Refuse to start over a training whose checkpoint is unfinished (unless ``overwrite``)."""
+    record_path = checkpoints.latest_dir(out, name) / f"{name}.json"
+    if overwrite or not record_path.is_file():
+        return
+    try:
+        record = checkpoints.read_record(record_path)
+    except ValueError:
+        return  # not ours to protect
+    if record.get("partial"):
+        raise ValueError(
+            f"{out} holds an unfinished training of {name} ({record['timesteps']} of "
+            f"{record['requested_timesteps']} steps); continue it with resume "
+            f"(shipgym train --resume {out}) or start over with overwrite=True (--overwrite)"
+        )
 
 
 def train(
@@ -162,8 +421,18 @@ def train(
     verbose: int = 0,
     hyperparameters: dict[str, Any] | None = None,
     env_kwargs: dict[str, Any] | None = None,
+    *,
+    tensorboard_log: str | Path | bool = True,
+    overwrite: bool = False,
+    callbacks: Sequence[Any] = (),
+    on_evaluation: Callable[[dict[str, Any]], None] | None = None,
 ) -> TrainResult:
-    """Train a PPO or SAC agent on ``env_id`` and save the best policy of the evaluations.
+    """Train a PPO or SAC agent on ``env_id``, checkpointing the best and the latest policy.
+
+    At every evaluation the best policy so far is the agent in ``out_dir`` (record marked
+    ``"partial": true``) and the latest state is a checkpoint that :func:`resume` continues
+    (layout in :mod:`shipgym.rl.checkpoints`), so an interrupted run loses at most the steps
+    since the last evaluation.
 
     Parameters
     ----------
@@ -177,12 +446,14 @@ def train(
         Seed of the networks and of the training sub-envs (``seed + i``); must be below
         ``VALIDATION_SEED - num_envs``.
     out_dir : path
-        Where ``<name>.zip`` and ``<name>.json`` go (:func:`agent_name`); created if missing.
+        Where ``<name>.zip`` and ``<name>.json`` go (:func:`agent_name`), with the
+        checkpoints in ``checkpoints/<name>/``; created if missing.
     num_envs : int, optional
         Training sub-envs; default from :func:`config`.
     eval_freq : int, optional
-        Environment steps between evaluations (default: about 20 over the run, and for PPO at
-        least one rollout, ``n_steps x num_envs``: its policy only changes once a rollout).
+        Environment steps between evaluations, and so between checkpoints (default: about 20
+        over the run, and for PPO at least one rollout, ``n_steps x num_envs``: its policy
+        only changes once a rollout).
     eval_episodes : int
         Validation episodes per evaluation (seeds ``VALIDATION_SEED + i``).
     progress_bar : bool
@@ -196,18 +467,23 @@ def train(
         Overrides of the algorithm's keyword arguments.
     env_kwargs : dict, optional
         Keyword arguments of the env (e.g. ``max_current_speed``).
+    tensorboard_log : path or bool
+        Folder of the TensorBoard runs (``True``: ``out_dir/tensorboard``; ``False``: none).
+        Each training is a run ``<name>_<k>`` in it; a resumed one continues its run.
+    overwrite : bool
+        Start over even when ``out_dir`` holds an unfinished training of this agent (by
+        default that is refused, so that a repeated command cannot wipe a long run).
+    callbacks : sequence of SB3 callbacks
+        Called after the evaluation callback at every step.
+    on_evaluation : callable, optional
+        Called with ``{"timesteps", "validation_return", "best_validation_return",
+        "best_timestep", "final"}`` after every evaluation (e.g. to report to Ray Tune).
 
     Returns
     -------
     TrainResult
     """
-    import stable_baselines3
-    import torch
     from stable_baselines3 import PPO, SAC
-    from stable_baselines3.common.callbacks import CallbackList, EvalCallback
-    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
-
-    from shipgym.rl.vec_env import ShipgymVecEnv
 
     cfg = config(env_id, algo)
     timesteps = cfg["timesteps"] if timesteps is None else timesteps
@@ -231,108 +507,167 @@ def train(
     if not isinstance(eval_freq, int) or eval_freq < 1:
         raise ValueError(f"eval_freq must be an integer >= 1, got {eval_freq!r}")
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     name = agent_name(env_id, algo)
+    _check_fresh_folder(out, name, overwrite)
+    out.mkdir(parents=True, exist_ok=True)
+    checkpoints.clear(out, name)
     env_kwargs = dict(env_kwargs or {})
+    tb_root = _tensorboard_root(out, tensorboard_log)
 
     norm_reward = algo == "ppo"
-    venv = VecNormalize(
-        VecMonitor(ShipgymVecEnv(env_id, num_envs, **env_kwargs)),
-        norm_obs=True,
-        norm_reward=norm_reward,
-        gamma=params.get("gamma", 0.99),
-    )
-    venv.seed(seed)
-    eval_env = VecNormalize(
-        VecMonitor(ShipgymVecEnv(env_id, eval_episodes, fixed_seed=VALIDATION_SEED, **env_kwargs)),
-        training=False,
-        norm_obs=True,
-        norm_reward=False,
+    venv, eval_env = _make_envs(
+        env_id, num_envs, seed, eval_episodes, env_kwargs, norm_reward, params.get("gamma", 0.99)
     )
     cls = {"ppo": PPO, "sac": SAC}[algo]
     model = cls("MlpPolicy", venv, seed=seed, verbose=verbose, device="cpu", **params)
-    model.set_logger(console_logger(verbose))
-
-    best: dict[str, Any] = {}
-    with tempfile.TemporaryDirectory() as tmp:
-
-        class _SaveBest(EvalCallback):
-            """EvalCallback that also keeps the normaliser of the best policy."""
-
-            def _on_step(self) -> bool:
-                previous = self.best_mean_reward
-                go_on = super()._on_step()
-                if self.best_mean_reward > previous:
-                    best["obs"] = _obs_normaliser(venv)
-                    best["timestep"] = int(self.num_timesteps)
-                    best["reward"] = float(self.best_mean_reward)
-                if progress is not None and self.n_calls % self.eval_freq == 0:
-                    rate = self.num_timesteps / max(time.perf_counter() - start, 1e-9)
-                    progress(
-                        f"{name}: {self.num_timesteps}/{timesteps} steps "
-                        f"({100 * self.num_timesteps / timesteps:.0f} %, {rate:.0f} steps/s), "
-                        f"validation return {self.last_mean_reward:.1f}, "
-                        f"best {self.best_mean_reward:.1f}"
-                    )
-                return go_on
-
-        # EvalCallback counts calls, one per vector step of num_envs env steps
-        callback = _SaveBest(
-            eval_env,
-            n_eval_episodes=eval_episodes,
-            eval_freq=max(eval_freq // num_envs, 1),
-            best_model_save_path=tmp,
-            log_path=tmp,
-            deterministic=True,
-            verbose=verbose,
-        )
-        start = time.perf_counter()
-        model.learn(timesteps, callback=CallbackList([callback]), progress_bar=progress_bar)
-        # a final evaluation, so the end of the run can win too
-        callback.n_calls = 0
-        callback._on_step()
-        wall = time.perf_counter() - start
-        curve = {
-            "timesteps": [int(t) for t in callback.evaluations_timesteps],
-            "mean_return": [float(np.mean(r)) for r in callback.evaluations_results],
-            "std_return": [float(np.std(r)) for r in callback.evaluations_results],
-        }
-        best_model = cls.load(os.path.join(tmp, "best_model.zip"), device="cpu")
-
-    model_path = out / f"{name}.zip"
-    best_model.save(model_path, exclude=["replay_buffer", "_last_obs", "_last_original_obs"])
-    meta = {
+    record = {
         "name": name,
         "env": env_id,
         "algo": algo,
-        "timesteps": int(model.num_timesteps),
+        "partial": True,
+        "timesteps": 0,
         "requested_timesteps": int(timesteps),
         "num_envs": int(num_envs),
         "seed": int(seed),
         "training_seeds": [int(seed), int(seed + num_envs - 1)],
         "validation_seeds": [VALIDATION_SEED, VALIDATION_SEED + eval_episodes - 1],
-        "wall_time_s": round(wall, 2),
-        "steps_per_s": round(model.num_timesteps / wall, 1),
-        "best_timestep": best.get("timestep"),
-        "best_validation_return": best.get("reward"),
-        "final_validation_return": curve["mean_return"][-1] if curve["mean_return"] else None,
-        "learning_curve": curve,
-        "obs_normaliser": best.get("obs", _obs_normaliser(venv)),
+        "eval_freq": int(eval_freq),
+        "wall_time_s": 0.0,
+        "steps_per_s": 0.0,
+        "best_timestep": None,
+        "best_validation_return": None,
+        "final_validation_return": None,
+        "learning_curve": {"timesteps": [], "mean_return": [], "std_return": []},
+        "obs_normaliser": _obs_normaliser(venv),
         "reward_normalised": norm_reward,
         "hyperparameters": params,
         "env_kwargs": env_kwargs,
-        "versions": {
-            "python": platform.python_version(),
-            "stable_baselines3": stable_baselines3.__version__,
-            "torch": torch.__version__,
-            "numpy": np.__version__,
-        },
-        "machine": f"{os.cpu_count()} CPUs, torch threads {torch.get_num_threads()}",
+        "resumed_at": [],
+        "tensorboard_run": None if tb_root is None else _next_tensorboard_run(tb_root, name),
+        # SAC's replay buffer (tens of MB at the default size) goes into the latest
+        # checkpoint, so that a resumed SAC run continues with the experience it had
+        "checkpoint_replay_buffer": algo == "sac",
+        "versions": _versions(),
+        "machine": _machine(),
     }
-    if not all(math.isfinite(v) for v in meta["obs_normaliser"]["mean"]):
-        raise RuntimeError(f"{name}: the observation normaliser is not finite")
-    meta_path = out / f"{name}.json"
-    _atomic_write_text(meta_path, json.dumps(meta, indent=2) + "\n")
-    venv.close()
-    eval_env.close()
-    return TrainResult(model_path=model_path, meta_path=meta_path, meta=meta)
+    run = _Run(out, record, model, venv, eval_env, tb_root, progress, on_evaluation, verbose)
+    return run.learn(callbacks, progress_bar, fresh=True)
+
+
+def _machine() -> str:
+    import torch
+
+    return f"{os.cpu_count()} CPUs, torch threads {torch.get_num_threads()}"
+
+
+def resume(
+    out_dir: str | Path,
+    env_id: str | None = None,
+    algo: str | None = None,
+    timesteps: int | None = None,
+    progress_bar: bool = True,
+    progress: Callable[[str], None] | None = None,
+    verbose: int = 0,
+    *,
+    tensorboard_log: str | Path | bool = True,
+    callbacks: Sequence[Any] = (),
+    on_evaluation: Callable[[dict[str, Any]], None] | None = None,
+) -> TrainResult:
+    """Continue the training in ``out_dir`` from its latest checkpoint.
+
+    The env, algorithm, hyperparameters, seeds and evaluation settings are the record's; the
+    model (with its optimiser state), the ``VecNormalize`` statistics and, for SAC, the replay
+    buffer are the checkpoint's. The timestep counter, the learning curve, the best policy and
+    the TensorBoard run continue. The training sub-envs start new episodes from their seeds
+    (the state of the episodes in progress is not saved), so a resumed run is not
+    bit-identical to an uninterrupted one.
+
+    Parameters
+    ----------
+    out_dir : path
+        The output folder of the interrupted :func:`train`.
+    env_id, algo : str, optional
+        Which agent, if the folder holds checkpoints of several (checked against the record).
+    timesteps : int, optional
+        The new total of environment steps (default: the record's ``requested_timesteps``);
+        must exceed the steps done.
+    progress_bar, progress, verbose, tensorboard_log, callbacks, on_evaluation
+        As in :func:`train`.
+
+    Returns
+    -------
+    TrainResult
+
+    Raises
+    ------
+    ValueError
+        When ``out_dir`` holds no usable checkpoint (see
+        :func:`shipgym.rl.checkpoints.find_latest`) or the training is already done.
+    """
+    from stable_baselines3 import PPO, SAC
+
+    out = Path(out_dir)
+    folder, record = checkpoints.find_latest(out, env_id, algo)
+    name, env_id, algo = record["name"], record["env"], record["algo"]
+    total = int(record["requested_timesteps"]) if timesteps is None else timesteps
+    if not isinstance(total, int) or total < 1:
+        raise ValueError(f"timesteps must be an integer >= 1, got {total!r}")
+    done = int(record["timesteps"])
+    if total <= done:
+        raise ValueError(
+            f"{name} in {out} has already trained {done} of {total} steps; give a larger total "
+            "(--timesteps N) to train on"
+        )
+    for key in ("eval_freq", "validation_seeds", "training_seeds", "tensorboard_run"):
+        if key not in record:
+            raise ValueError(f"{folder / (name + '.json')} cannot be resumed (missing {key})")
+    eval_episodes = int(record["validation_seeds"][1]) - int(record["validation_seeds"][0]) + 1
+    params = dict(record["hyperparameters"])
+    venv, eval_env = _make_envs(
+        env_id,
+        int(record["num_envs"]),
+        int(record["seed"]),
+        eval_episodes,
+        dict(record.get("env_kwargs", {})),
+        bool(record.get("reward_normalised", algo == "ppo")),
+        params.get("gamma", 0.99),
+        vecnormalize_path=folder / checkpoints.VECNORMALIZE,
+    )
+    cls = {"ppo": PPO, "sac": SAC}[algo]
+    model = cls.load(folder / f"{name}.zip", env=venv, device="cpu")
+    buffer = folder / checkpoints.REPLAY_BUFFER
+    if algo == "sac" and buffer.is_file():
+        model.load_replay_buffer(buffer)
+    steps = int(model.num_timesteps)
+    best: dict[str, Any] = {}
+    best_path = checkpoints.best_dir(out, name) / f"{name}.json"
+    if best_path.is_file():
+        best_record = checkpoints.read_record(best_path)
+        if best_record.get("best_validation_return") is not None:
+            best = {
+                "obs": best_record["obs_normaliser"],
+                "timestep": best_record["best_timestep"],
+                "reward": float(best_record["best_validation_return"]),
+            }
+    tb_root = _tensorboard_root(out, tensorboard_log)
+    if tb_root is not None and record["tensorboard_run"] is None:
+        record["tensorboard_run"] = _next_tensorboard_run(tb_root, name)
+    curve = record["learning_curve"]
+    # evaluations after the checkpoint's step (none, unless the files were edited) are dropped
+    keep = sum(1 for t in curve["timesteps"] if t <= steps)
+    record = {
+        **record,
+        "partial": True,
+        "requested_timesteps": int(total),
+        "learning_curve": {key: list(values[:keep]) for key, values in curve.items()},
+        "resumed_at": [*record.get("resumed_at", []), steps],
+        "checkpoint_replay_buffer": algo == "sac",
+        "versions": _versions(),
+        "machine": _machine(),
+    }
+    if progress is not None:
+        progress(f"{name}: resuming at step {steps} of {total} from {folder}")
+    run = _Run(
+        out, record, model, venv, eval_env, tb_root, progress, on_evaluation, verbose, best=best
+    )
+    return run.learn(callbacks, progress_bar, fresh=False)
