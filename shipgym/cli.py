@@ -9,10 +9,14 @@ Subcommands::
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
     shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N]
                      [--seed S] [--agents DIR] [--json OUT] [--plot DIR]
+                     [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
+                  [--tensorboard DIR | --no-tensorboard] [--overwrite]
+    shipgym train --resume DIR [--timesteps N]
+    shipgym train --ray [ADDRESS] [--ray-cpus N] --sweep FILE [--seeds S1,S2,...] [--out DIR]
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
                       [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]
-                      [--no-throughput]
+                      [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N] [--no-throughput]
     shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
@@ -543,15 +547,81 @@ def _build_simulate(sub: Any) -> None:
 # ------------------------------------------------------------------------------------------
 # evaluate
 # ------------------------------------------------------------------------------------------
+def _ray_address(text: str) -> str:
+    """``--ray``: ``local`` (Ray on this machine), ``auto`` or ``[ray://]host:port``."""
+    from shipgym.cluster import parse_address
+
+    try:
+        address = parse_address(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("bad Ray address ")) from None
+    return "local" if address is None else address
+
+
+def _add_ray_flags(p: argparse.ArgumentParser, what: str) -> None:
+    """``--ray [ADDRESS]``, ``--ray-cpus N`` and ``--task-episodes N``."""
+    p.add_argument(
+        "--ray",
+        nargs="?",
+        const="local",
+        default=None,
+        type=_ray_address,
+        metavar="ADDRESS",
+        help=f"run the {what} as Ray tasks: without ADDRESS on a Ray started on this machine, "
+        "with HOST:PORT (as 'ray start --head' prints it) or 'auto' on that cluster; the "
+        "results are those of a local run",
+    )
+    p.add_argument(
+        "--ray-cpus",
+        type=_int_in(1, 4096),
+        default=None,
+        metavar="N",
+        help="CPUs of the local Ray started by --ray (default: every core)",
+    )
+    p.add_argument(
+        "--task-episodes",
+        type=_int_in(1, MAX_EPISODES),
+        default=None,
+        metavar="N",
+        help="episodes per Ray task (default: about four tasks per CPU of the cluster)",
+    )
+
+
+def _ray_options(args: argparse.Namespace) -> tuple[str | None, int | None, int | None] | None:
+    """``(address or None for a local Ray, CPUs, episodes per task)`` of ``--ray``, or None
+    without it; refuses the Ray flags that do not go together."""
+    if args.ray is None:
+        for flag, value in (("--ray-cpus", args.ray_cpus), ("--task-episodes", args.task_episodes)):
+            if value is not None:
+                raise ValueError(f"{flag} goes with --ray (the episodes run as Ray tasks)")
+        return None
+    address = None if args.ray == "local" else args.ray
+    if address is not None and args.ray_cpus is not None:
+        raise ValueError(
+            f"--ray-cpus is for a Ray started on this machine (--ray without an address); the "
+            f"cluster at {address} has its own CPUs"
+        )
+    return address, args.ray_cpus, args.task_episodes
+
+
+def _campaign_failed(exc: Exception) -> int:
+    """Print a failed episode or Ray task (its message names env, controller, condition
+    and seed) as one line; exit code 1."""
+    print(f"{PROG}: error: {exc}", file=sys.stderr)
+    return 1
+
+
 def _run_evaluate(args: argparse.Namespace) -> int:
     import json
 
     from shipgym.benchmark import evaluate, make_policy
-    from shipgym.benchmark.evaluate import BLOW_UP
+    from shipgym.benchmark.evaluate import BLOW_UP, EpisodeError
     from shipgym.benchmark.plots import episode_figures
+    from shipgym.cluster import ClusterTaskError
 
     json_path = _output_path(args.json, "--json", ".json")
     plot_dir = None if args.plot is None else _output_dir(args.plot, "--plot")
+    ray = _ray_options(args)
     policy = make_policy(args.controller, args.env, args.agents)
     if hasattr(policy, "meta"):
         from shipgym.benchmark.runner import check_seeds_disjoint
@@ -560,16 +630,37 @@ def _run_evaluate(args: argparse.Namespace) -> int:
             check_seeds_disjoint(policy.meta, args.seed, args.episodes)
         except ValueError as exc:
             print(f"{PROG}: warning: {exc}", file=sys.stderr)
-    result = evaluate(
-        args.env,
-        policy,
-        args.controller,
-        episodes=args.episodes,
-        seed=args.seed,
-        env_kwargs={}
-        if args.max_current_speed is None
-        else {"max_current_speed": args.max_current_speed},
+    env_kwargs = (
+        {} if args.max_current_speed is None else {"max_current_speed": args.max_current_speed}
     )
+    try:
+        if ray is None:
+            result = evaluate(
+                args.env,
+                policy,
+                args.controller,
+                episodes=args.episodes,
+                seed=args.seed,
+                env_kwargs=env_kwargs,
+            )
+        else:
+            from shipgym.benchmark.runner import evaluate_on_ray
+
+            address, cpus, task_size = ray
+            result = evaluate_on_ray(
+                args.env,
+                args.controller,
+                args.episodes,
+                args.seed,
+                address=address,
+                num_cpus=cpus,
+                task_size=task_size,
+                env_kwargs=env_kwargs,
+                agents_dir=args.agents,
+                keep_logs=None if plot_dir is not None else 0,
+            )
+    except (EpisodeError, ClusterTaskError) as exc:
+        return _campaign_failed(exc)
     summary = result.to_dict()
     print(
         f"{args.env} controller {args.controller}: {args.episodes} episodes from seed {args.seed}"
@@ -634,36 +725,146 @@ def _build_evaluate(sub: Any) -> None:
     p.add_argument(
         "--plot", default=None, metavar="DIR", help="write a figure per episode into DIR"
     )
+    _add_ray_flags(p, "episodes")
     p.set_defaults(handler=_run_evaluate)
 
 
 # ------------------------------------------------------------------------------------------
 # train
 # ------------------------------------------------------------------------------------------
-def _run_train(args: argparse.Namespace) -> int:
-    from shipgym.rl.train import config, train
+#: Flags that ``--resume`` takes from the record and so refuses (dest -> flag).
+_RESUME_FIXED = {
+    "seed": "--seed",
+    "num_envs": "--num-envs",
+    "eval_freq": "--eval-freq",
+    "eval_episodes": "--eval-episodes",
+    "sweep": "--sweep",
+    "seeds": "--seeds",
+    "ray": "--ray",
+}
 
-    cfg = config(args.env, args.algo)
-    out = _output_dir(args.out, "--out")
-    timesteps = args.timesteps or cfg["timesteps"]
+
+def _seed_list(text: str) -> list[int]:
+    """An argparse type: comma-separated seeds, e.g. ``0,1,2``."""
+    seeds = []
+    for part in text.split(","):
+        try:
+            seed = int(part)
+        except ValueError:
+            seed = -1
+        if not 0 <= seed <= MAX_SEED:
+            raise argparse.ArgumentTypeError(
+                f"must be comma-separated integers in [0, {MAX_SEED:,}], got {part!r} in {text!r}"
+            )
+        seeds.append(seed)
+    if len(set(seeds)) != len(seeds):
+        raise argparse.ArgumentTypeError(f"repeats a seed: {text!r}")
+    return seeds
+
+
+def _tensorboard_option(args: argparse.Namespace) -> str | bool:
+    if args.no_tensorboard:
+        return False
+    return True if args.tensorboard is None else str(_output_dir(args.tensorboard, "--tensorboard"))
+
+
+def _interrupted(out: Path, env_id: str | None, algo: str | None) -> int:
+    """Say what an interrupted training left and how to continue it; exit code 130."""
+    from shipgym.rl.checkpoints import resumable
+
+    found = resumable(out)
+    names = [
+        n
+        for n in found
+        if env_id is None
+        or algo is None
+        or n == f"{env_id.split('/')[-1]}-{algo}"  # the agent of this command only
+    ]
+    if names:
+        print(
+            f"{PROG}: interrupted; the best agent so far is in {out} (record marked partial), "
+            f"the latest checkpoint in {found[names[0]]}; continue with: "
+            f"{PROG} train --resume {out}",
+            file=sys.stderr,
+        )
+    else:
+        print(
+            f"{PROG}: interrupted before the first evaluation; nothing was saved", file=sys.stderr
+        )
+    return 130
+
+
+def _run_train(args: argparse.Namespace) -> int:
+    import signal
+
+    if args.ray is not None or args.sweep is not None or args.seeds is not None:
+        return _run_train_sweep(args)
+    if args.ray_cpus is not None:
+        raise ValueError("--ray-cpus goes with --ray (a sweep on a Ray started on this machine)")
+    if args.resume is not None:
+        given = [flag for dest, flag in _RESUME_FIXED.items() if getattr(args, dest) is not None]
+        if args.overwrite:
+            given.append("--overwrite")
+        if given:
+            raise ValueError(
+                f"--resume continues with the settings of the training's record; {given[0]} "
+                "cannot be given with it (allowed: --env, --algo, --timesteps, --tensorboard, "
+                "--no-tensorboard, --quiet)"
+            )
+        out = Path(args.resume)
+    else:
+        if args.env is None or args.algo is None:
+            raise ValueError(
+                "--env and --algo are required (or --resume DIR to continue a training)"
+            )
+        out = _output_dir(args.out, "--out")
+    tensorboard = _tensorboard_option(args)
     bar = not args.quiet and sys.stderr.isatty()
-    print(
-        f"training {args.algo} on {args.env}: {timesteps} steps, seed {args.seed}, "
-        f"{args.num_envs or cfg['num_envs']} sub-envs, into {args.out}",
-        flush=True,
-    )
-    result = train(
-        args.env,
-        args.algo,
-        timesteps=timesteps,
-        seed=args.seed,
-        out_dir=out,
-        num_envs=args.num_envs,
-        eval_freq=args.eval_freq,
-        eval_episodes=args.eval_episodes,
-        progress_bar=bar,
-        progress=None if (bar or args.quiet) else _progress,
-    )
+    progress = None if (bar or args.quiet) else _progress
+    # SIGTERM (a batch system's stop, kill) ends the run like Ctrl-C: the checkpoints of the
+    # last evaluation stay, and the message says how to continue
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        if args.resume is not None:
+            from shipgym.rl.train import resume
+
+            result = resume(
+                out,
+                args.env,
+                args.algo,
+                timesteps=args.timesteps,
+                progress_bar=bar,
+                progress=_progress if not args.quiet else None,
+                tensorboard_log=tensorboard,
+            )
+        else:
+            from shipgym.rl.train import config, train
+
+            cfg = config(args.env, args.algo)
+            timesteps = args.timesteps or cfg["timesteps"]
+            print(
+                f"training {args.algo} on {args.env}: {timesteps} steps, seed {args.seed or 0}, "
+                f"{args.num_envs or cfg['num_envs']} sub-envs, into {args.out}",
+                flush=True,
+            )
+            result = train(
+                args.env,
+                args.algo,
+                timesteps=timesteps,
+                seed=args.seed or 0,
+                out_dir=out,
+                num_envs=args.num_envs,
+                eval_freq=args.eval_freq,
+                eval_episodes=args.eval_episodes or 16,
+                progress_bar=bar,
+                progress=progress,
+                tensorboard_log=tensorboard,
+                overwrite=args.overwrite,
+            )
+    except KeyboardInterrupt:
+        return _interrupted(out, args.env, args.algo)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     meta = result.meta
     print(
         f"{meta['name']}: {meta['timesteps']} steps in {meta['wall_time_s']:.0f} s "
@@ -671,7 +872,67 @@ def _run_train(args: argparse.Namespace) -> int:
         f"{meta['best_validation_return']:.1f} at step {meta['best_timestep']}"
     )
     print(f"wrote {result.model_path} and {result.meta_path}")
+    if meta.get("tensorboard_run") and tensorboard is not False:
+        logdir = out / "tensorboard" if tensorboard is True else Path(tensorboard)
+        print(f"TensorBoard: tensorboard --logdir {logdir}")
     return 0
+
+
+def _run_train_sweep(args: argparse.Namespace) -> int:
+    if args.ray is None:
+        flag = "--sweep" if args.sweep is not None else "--seeds"
+        raise ValueError(
+            f"{flag} runs trials on Ray: add --ray (a Ray on this machine) or --ray ADDRESS"
+        )
+    for dest, flag in (("resume", "--resume"), ("seed", "--seed"), ("overwrite", "--overwrite")):
+        if getattr(args, dest) not in (None, False):
+            hint = " (a sweep resumes its unfinished trials by itself)" if dest == "resume" else ""
+            hint = hint or (" (use --seeds S1,S2,...)" if dest == "seed" else "")
+            raise ValueError(f"{flag} does not go with --ray{hint}")
+    if args.no_tensorboard or args.tensorboard is not None:
+        raise ValueError(
+            "a sweep writes each trial's TensorBoard run into the trial's folder; "
+            "--tensorboard/--no-tensorboard do not go with --ray"
+        )
+    from shipgym.rl.sweep import load_sweep, run_sweep
+
+    address = None if args.ray == "local" else args.ray
+    if address is not None and args.ray_cpus is not None:
+        raise ValueError(
+            f"--ray-cpus is for a Ray started on this machine (--ray without an address); the "
+            f"cluster at {address} has its own CPUs"
+        )
+    spec = load_sweep(
+        args.sweep,
+        env=args.env,
+        algo=args.algo,
+        timesteps=args.timesteps,
+        num_envs=args.num_envs,
+        eval_freq=args.eval_freq,
+        eval_episodes=args.eval_episodes,
+        seeds=args.seeds,
+    )
+    out = _output_dir(args.out, "--out")
+    try:
+        result = run_sweep(
+            spec,
+            out,
+            address=address,
+            num_cpus=args.ray_cpus,
+            progress=None if args.quiet else _progress,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"{PROG}: interrupted; every trial keeps its best agent and latest checkpoint under "
+            f"{out / 'trials'}; the same command continues the unfinished ones",
+            file=sys.stderr,
+        )
+        return 130
+    for line in result.table():
+        print(line)
+    for path in result.outputs:
+        print(f"wrote {path}")
+    return 0 if not result.failed else 1
 
 
 def _build_train(sub: Any) -> None:
@@ -680,30 +941,36 @@ def _build_train(sub: Any) -> None:
 
     p = sub.add_parser(
         "train",
-        help="train a PPO or SAC agent (stable-baselines3) on an env",
+        help="train a PPO or SAC agent (stable-baselines3) on an env, or a sweep on Ray",
         description=(
             "Train a stable-baselines3 agent on the NumPy-batched vector env (one kernel call "
             "steps every sub-env), with observation normalisation and an evaluation callback "
             "on fixed validation seeds that keeps the best policy. Writes DIR/<name>.zip and "
-            "DIR/<name>.json (budget, seeds, wall time, learning curve, normaliser). Needs "
-            "the rl extra: pip install 'shipgym[rl]'."
+            "DIR/<name>.json (budget, seeds, wall time, learning curve, normaliser) at every "
+            "evaluation (the best policy so far, its record marked partial until the end), the "
+            "latest state in DIR/checkpoints/<name>/latest (continue it with --resume DIR) "
+            "and TensorBoard logs in DIR/tensorboard. With --ray, trains one agent per "
+            "configuration of a --sweep file and seed of --seeds as Ray Tune trials, each in "
+            "its own folder under DIR/trials, and writes a summary table and figure. Needs "
+            "the rl extra (pip install 'shipgym[rl]'); --ray the cluster extra."
         ),
     )
-    p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
-    p.add_argument("--algo", required=True, choices=ALGOS, help="algorithm")
+    p.add_argument("--env", default=None, choices=ENV_IDS, help="environment id")
+    p.add_argument("--algo", default=None, choices=ALGOS, help="algorithm")
     p.add_argument(
         "--timesteps",
         type=_int_in(1, 10**9),
         default=None,
         metavar="N",
-        help="environment steps (default: the shipped agent's budget)",
+        help="environment steps (default: the shipped agent's budget; with --resume the new "
+        "total, default the recorded one)",
     )
     p.add_argument(
         "--seed",
         type=_int_in(0, MAX_SEED),
-        default=0,
+        default=None,
         metavar="S",
-        help="seed of the networks; training sub-env i gets S + i (%(default)s)",
+        help="seed of the networks; training sub-env i gets S + i (default 0)",
     )
     p.add_argument("--out", default="shipgym-agents", metavar="DIR", help="%(default)s")
     p.add_argument(
@@ -718,14 +985,64 @@ def _build_train(sub: Any) -> None:
         type=_int_in(1, 10**9),
         default=None,
         metavar="N",
-        help="env steps between evaluations (default: 1/20 of the budget; PPO: at least a rollout)",
+        help="env steps between evaluations and checkpoints (default: 1/20 of the budget; "
+        "PPO: at least a rollout)",
     )
     p.add_argument(
         "--eval-episodes",
         type=_int_in(1, 10**4),
-        default=16,
+        default=None,
         metavar="N",
-        help="validation episodes per evaluation (%(default)s)",
+        help="validation episodes per evaluation (default 16)",
+    )
+    p.add_argument(
+        "--resume",
+        default=None,
+        metavar="DIR",
+        help="continue the training in DIR from its latest checkpoint (env, algorithm and "
+        "hyperparameters from its record; --env/--algo pick one if DIR holds several)",
+    )
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start over even if DIR holds an unfinished training of this agent",
+    )
+    p.add_argument(
+        "--tensorboard",
+        default=None,
+        metavar="DIR",
+        help="folder of the TensorBoard runs (default: tensorboard/ in the output folder)",
+    )
+    p.add_argument("--no-tensorboard", action="store_true", help="write no TensorBoard logs")
+    p.add_argument(
+        "--ray",
+        nargs="?",
+        const="local",
+        default=None,
+        metavar="ADDRESS",
+        help="run a sweep as Ray Tune trials: without ADDRESS on a Ray started on this machine, "
+        "with HOST:PORT (as 'ray start --head' prints it) or 'auto' on that cluster (DIR must "
+        "then be on a filesystem every node sees)",
+    )
+    p.add_argument(
+        "--ray-cpus",
+        type=_int_in(1, 4096),
+        default=None,
+        metavar="N",
+        help="CPUs of the local Ray started by --ray (default: every core); one per trial",
+    )
+    p.add_argument(
+        "--sweep",
+        default=None,
+        metavar="FILE",
+        help="YAML or JSON file of hyperparameter choices (a grid; see the README)",
+    )
+    p.add_argument(
+        "--seeds",
+        type=_seed_list,
+        default=None,
+        metavar="S1,S2,...",
+        help="with --ray: train every configuration once per seed (default: 0)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.set_defaults(handler=_run_train)
@@ -737,6 +1054,7 @@ def _build_train(sub: Any) -> None:
 def _run_benchmark(args: argparse.Namespace) -> int:
     import json
 
+    from shipgym.benchmark.evaluate import EpisodeError
     from shipgym.benchmark.plots import (
         plot_benchmark_metrics,
         plot_benchmark_robustness,
@@ -745,7 +1063,14 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     )
     from shipgym.benchmark.runner import CONDITIONS, run_benchmark
     from shipgym.benchmark.throughput import ppo_throughput, throughput_table
+    from shipgym.cluster import ClusterTaskError
 
+    ray = _ray_options(args)
+    if ray is not None and args.jobs is not None:
+        raise ValueError(
+            "--jobs sets the local process pool; with --ray the Ray cluster's CPUs run the "
+            "episodes (--ray-cpus for a Ray started on this machine)"
+        )
     out = _output_dir(args.out, "--out")
     json_path = _output_path(args.json, "--json", ".json") or out / "benchmark.json"
     csv_path = _output_path(args.csv, "--csv", ".csv") or out / "benchmark.csv"
@@ -758,15 +1083,21 @@ def _run_benchmark(args: argparse.Namespace) -> int:
         kwargs["envs"] = envs
     if controllers:
         kwargs["controllers"] = controllers
-    result = run_benchmark(
-        episodes=args.episodes,
-        seed=args.seed,
-        conditions=args.condition or CONDITIONS,
-        agents_dir=args.agents,
-        progress=progress,
-        jobs=args.jobs,
-        **kwargs,
-    )
+    if ray is not None:
+        address, cpus, task_size = ray
+        kwargs.update(ray=address or True, ray_cpus=cpus, task_size=task_size)
+    try:
+        result = run_benchmark(
+            episodes=args.episodes,
+            seed=args.seed,
+            conditions=args.condition or CONDITIONS,
+            agents_dir=args.agents,
+            progress=progress,
+            jobs=args.jobs,
+            **kwargs,
+        )
+    except (EpisodeError, ClusterTaskError) as exc:
+        return _campaign_failed(exc)
     print(result.table())
     print(f"({result.runtime_s:.0f} s)")
     outputs: list[tuple[Path, Callable[[Path], Any]]] = [
@@ -882,6 +1213,7 @@ def _build_benchmark(sub: Any) -> None:
         metavar="N",
         help="evaluations at once, one process each (default: one per core)",
     )
+    _add_ray_flags(p, "evaluations' episodes")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(handler=_run_benchmark)
 

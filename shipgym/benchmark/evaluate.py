@@ -1,7 +1,14 @@
 """Run a policy on an environment over seeded episodes and compute the task metrics.
 
 Episode ``k`` is reset with seed ``seed + k``, so every policy sees the same initial states,
-setpoints, paths, targets and current draws. Metrics (means over episodes):
+setpoints, paths, targets and current draws. An episode's numbers depend on its seed only, not
+on how many episodes run beside it: a batched policy (a neural network) is always called on
+blocks of :data:`POLICY_BLOCK` rows in which the episode of seed ``s`` takes row
+``s % POLICY_BLOCK`` (matrix kernels round a row differently by its place in the batch), so a
+campaign split into batches of seeds (on a Ray cluster, :mod:`shipgym.benchmark.runner`) and
+merged with :func:`merge_results` gives the numbers of one run. An error raised in an episode
+becomes an :class:`EpisodeError` naming the env, controller, condition and seed. Metrics (means
+over episodes):
 
 * heading envs: ``heading_rms_deg`` (RMS heading error over the whole episode),
   ``overshoot_deg`` (largest excursion past a new setpoint, in the direction of the change,
@@ -84,6 +91,36 @@ STRAIGHT_AFTER_S = 25.0
 Gunnerus legs take 50-70 s; 25 s is about 4 ship lengths of travel)."""
 REVERSAL_DEADBAND = math.radians(0.05)
 """Rudder moves smaller than this [rad] are not counted as reversals."""
+POLICY_BLOCK = 64
+"""Rows of every call of a batched policy's ``act_batch`` (padded with zero observations)."""
+
+
+class EpisodeError(RuntimeError):
+    """An episode of an evaluation raised an error; the message names the env, controller,
+    condition and seed, the original error is the ``__cause__``.
+
+    Attributes
+    ----------
+    env, controller, condition : str
+        The evaluation the episode belongs to.
+    seeds : tuple of int
+        The seed of the failing episode (several when a batched policy call failed for a
+        block of episodes and no single one could be singled out).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        env: str = "",
+        controller: str = "",
+        condition: str = "",
+        seeds: tuple[int, ...] = (),
+    ) -> None:
+        super().__init__(message)
+        self.env = env
+        self.controller = controller
+        self.condition = condition
+        self.seeds = seeds
 
 
 @dataclass
@@ -356,6 +393,35 @@ def _record_step(
     return obs, bool(terminated or truncated)
 
 
+def _act_in_blocks(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> np.ndarray:
+    """``policy.act_batch`` on the rows ``obs`` of the episodes ``seeds``, called on blocks
+    of :data:`POLICY_BLOCK` rows with seed ``s`` in row ``s % POLICY_BLOCK`` (zeros elsewhere)."""
+    blocks: dict[int, list[int]] = {}
+    for j, s in enumerate(seeds):
+        blocks.setdefault(s // POLICY_BLOCK, []).append(j)
+    out: np.ndarray | None = None
+    for members in blocks.values():
+        rows = [seeds[j] % POLICY_BLOCK for j in members]
+        block = np.zeros((POLICY_BLOCK, *obs.shape[1:]), dtype=obs.dtype)
+        block[rows] = obs[members]
+        actions = np.asarray(policy.act_batch(block), dtype=np.float32)
+        if out is None:
+            out = np.empty((len(seeds), *actions.shape[1:]), dtype=np.float32)
+        out[members] = actions[rows]
+    assert out is not None  # at least one seed
+    return out
+
+
+def _failing_seeds(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> tuple[int, ...]:
+    """The seeds whose rows alone make ``act_batch`` raise (all of ``seeds`` if none does)."""
+    for j, s in enumerate(seeds):
+        try:
+            _act_in_blocks(policy, obs[j : j + 1], [s])
+        except Exception:
+            return (s,)
+    return tuple(seeds)
+
+
 def evaluate(
     env_id: str,
     policy: Any,
@@ -377,8 +443,9 @@ def evaluate(
     policy : object
         Has ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (normalised). A
         memoryless policy that also has ``act_batch(obs) -> actions`` (a batch of
-        observations, one row per episode) runs all episodes in lockstep, one call per step;
-        the episodes and results are the same.
+        observations, one row per episode) runs all episodes in lockstep, one call per step
+        and block of :data:`POLICY_BLOCK` episodes; an episode's actions do not depend on the
+        other episodes of the run.
     controller : str
         Name recorded in the result.
     episodes, seed : int
@@ -400,6 +467,12 @@ def evaluate(
     Returns
     -------
     EvaluationResult
+
+    Raises
+    ------
+    EpisodeError
+        If an episode raises (in the env, a wrapper, the policy or the metrics): names the
+        env, controller, condition and the episode's seed.
     """
     if env_id not in ENV_IDS:
         raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
@@ -409,6 +482,20 @@ def evaluate(
 
         def progress(line: str) -> None:
             print(line, file=sys.stderr, flush=True)
+
+    def failed(seeds: Sequence[int], exc: Exception) -> EpisodeError:
+        which = (
+            f"episode with seed {seeds[0]}"
+            if len(seeds) == 1
+            else f"one of the episodes with seeds {', '.join(map(str, seeds))}"
+        )
+        return EpisodeError(
+            f"{env_id} {controller} ({condition}): {which} failed: {type(exc).__name__}: {exc}",
+            env=env_id,
+            controller=controller,
+            condition=condition,
+            seeds=tuple(seeds),
+        )
 
     batched = hasattr(policy, "act_batch")
     n_envs = episodes if batched else 1
@@ -420,56 +507,76 @@ def evaluate(
     def finish(log: EpisodeLog, targets: list[np.ndarray]) -> None:
         if targets:
             log.extras["target"] = np.asarray(targets)
-        logs.append(log)
-        head = f"{env_id} {controller} episode {len(logs)}/{episodes} (seed {log.seed}): "
+        head = f"{env_id} {controller} episode {len(logs) + 1}/{episodes} (seed {log.seed}): "
         if log.info[-1]["termination_reason"] == BLOW_UP:
-            per_episode.append(dict.fromkeys(METRICS[env_id], math.nan))
-            progress(head + f"numerical blow-up at step {len(log.time)}: no return, no metrics")
-            return
-        metrics = episode_metrics(env_id, log, dt)
+            metrics = dict.fromkeys(METRICS[env_id], math.nan)
+            line = head + f"numerical blow-up at step {len(log.time)}: no return, no metrics"
+        else:
+            try:
+                metrics = episode_metrics(env_id, log, dt)
+            except Exception as exc:
+                raise failed([log.seed], exc) from exc
+            line = (
+                head
+                + f"return {log.episode_return:.1f}, "
+                + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
+            )
+        logs.append(log)
         per_episode.append(metrics)
-        progress(
-            head
-            + f"return {log.episode_return:.1f}, "
-            + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
-        )
+        progress(line)
 
-    if batched:
-        # memoryless policy: every episode at once, one policy call per step for all ships
-        starts = [_start(env, seed + k, reset_options) for k, env in enumerate(envs)]
-        ep_logs = [log for log, _, _ in starts]
-        obs = np.stack([o for _, o, _ in starts])
-        targets: list[list[np.ndarray]] = [[] for _ in envs]
-        active = list(range(episodes))
-        for k, (_, o, info) in enumerate(starts):
-            policy.reset(envs[k].unwrapped, o, info)
-        while active:
-            actions = np.asarray(policy.act_batch(obs[active]), dtype=np.float32)
-            still = []
-            for j, k in enumerate(active):
-                o, done = _record_step(envs[k], ep_logs[k], actions[j], targets[k], dt)
-                obs[k] = o
-                if done:
-                    finish(ep_logs[k], targets[k])
-                else:
-                    still.append(k)
-            active = still
-        order = np.argsort([log.seed for log in logs])
-        logs[:] = [logs[i] for i in order]
-        per_episode[:] = [per_episode[i] for i in order]
-    else:
-        env = envs[0]
-        for k in range(episodes):
-            log, obs_k, info = _start(env, seed + k, reset_options)
-            policy.reset(env.unwrapped, obs_k, info)
-            targets_k: list[np.ndarray] = []
-            done = False
-            while not done:
-                action = np.asarray(policy.act(obs_k, log.info[-1] if log.info else info))
-                obs_k, done = _record_step(env, log, action, targets_k, dt)
-            finish(log, targets_k)
-    for env in envs:
-        env.close()
+    try:
+        if batched:
+            # memoryless policy: every episode at once, one policy call per step and block
+            starts = []
+            for k, env in enumerate(envs):
+                try:
+                    starts.append(_start(env, seed + k, reset_options))
+                    policy.reset(env.unwrapped, starts[-1][1], starts[-1][2])
+                except Exception as exc:
+                    raise failed([seed + k], exc) from exc
+            ep_logs = [log for log, _, _ in starts]
+            obs = np.stack([o for _, o, _ in starts])
+            targets: list[list[np.ndarray]] = [[] for _ in envs]
+            active = list(range(episodes))
+            while active:
+                seeds = [seed + k for k in active]
+                try:
+                    actions = _act_in_blocks(policy, obs[active], seeds)
+                except Exception as exc:
+                    raise failed(_failing_seeds(policy, obs[active], seeds), exc) from exc
+                still = []
+                for j, k in enumerate(active):
+                    try:
+                        o, done = _record_step(envs[k], ep_logs[k], actions[j], targets[k], dt)
+                    except Exception as exc:
+                        raise failed([seed + k], exc) from exc
+                    obs[k] = o
+                    if done:
+                        finish(ep_logs[k], targets[k])
+                    else:
+                        still.append(k)
+                active = still
+            order = np.argsort([log.seed for log in logs])
+            logs[:] = [logs[i] for i in order]
+            per_episode[:] = [per_episode[i] for i in order]
+        else:
+            env = envs[0]
+            for k in range(episodes):
+                try:
+                    log, obs_k, info = _start(env, seed + k, reset_options)
+                    policy.reset(env.unwrapped, obs_k, info)
+                    targets_k: list[np.ndarray] = []
+                    done = False
+                    while not done:
+                        action = np.asarray(policy.act(obs_k, log.info[-1] if log.info else info))
+                        obs_k, done = _record_step(env, log, action, targets_k, dt)
+                except Exception as exc:
+                    raise failed([seed + k], exc) from exc
+                finish(log, targets_k)
+    finally:
+        for env in envs:
+            env.close()
     return EvaluationResult(
         env=env_id,
         controller=controller,
@@ -485,4 +592,49 @@ def evaluate(
         condition=condition,
         terminations=[str(log.info[-1]["termination_reason"]) for log in logs],
         lengths=[len(log.time) for log in logs],
+    )
+
+
+def merge_results(parts: Sequence[EvaluationResult]) -> EvaluationResult:
+    """One evaluation from evaluations of consecutive seed ranges of the same env,
+    controller, condition and options (the batches of a campaign split into tasks).
+
+    The episodes, per-episode values and logs are concatenated in seed order; the result
+    equals that of one :func:`evaluate` over all the seeds.
+
+    Raises
+    ------
+    ValueError
+        If ``parts`` is empty, mixes evaluations, or its seed ranges leave a gap or overlap.
+    """
+    if not parts:
+        raise ValueError("no evaluations to merge")
+    parts = sorted(parts, key=lambda r: r.seed)
+    first = parts[0]
+    key = (first.env, first.controller, first.condition, first.options)
+    expected = first.seed
+    for part in parts:
+        if (part.env, part.controller, part.condition, part.options) != key:
+            raise ValueError(
+                f"cannot merge {part.env} {part.controller} ({part.condition}) into "
+                f"{first.env} {first.controller} ({first.condition}): different evaluations"
+            )
+        if part.seed != expected:
+            raise ValueError(
+                f"seed ranges do not join: expected a part from seed {expected}, got one from "
+                f"seed {part.seed}"
+            )
+        expected = part.seed + part.episodes
+    return EvaluationResult(
+        env=first.env,
+        controller=first.controller,
+        episodes=sum(p.episodes for p in parts),
+        seed=first.seed,
+        returns=[r for p in parts for r in p.returns],
+        per_episode=[m for p in parts for m in p.per_episode],
+        logs=[log for p in parts for log in p.logs],
+        options=dict(first.options),
+        condition=first.condition,
+        terminations=[t for p in parts for t in p.terminations],
+        lengths=[n for p in parts for n in p.lengths],
     )

@@ -24,25 +24,39 @@ controller). Conditions:
 The ``zero`` command, a baseline, runs in the nominal condition only. The default first seed,
 :data:`shipgym.rl.train.BENCHMARK_SEED`, lies outside every agent's training and validation
 seeds and the tuning seeds; :func:`run_benchmark` checks that against each agent's record.
+
+Campaigns that outgrow one machine run on Ray (``ray=`` of :func:`run_benchmark` and
+:func:`run_evaluation`, ``--ray`` of the commands): each cell's episodes are split into
+:class:`EpisodeBatch` es of consecutive seeds, each batch is one Ray task running
+:func:`~shipgym.benchmark.evaluate.evaluate`, and the batches are merged back
+(:func:`~shipgym.benchmark.evaluate.merge_results`). An episode's numbers depend on its seed
+only, so the results equal those of a local run with the same seeds.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import math
 import multiprocessing
 import os
 import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 
-from shipgym.benchmark.evaluate import METRICS, EvaluationResult, evaluate
+from shipgym.benchmark.evaluate import (
+    METRICS,
+    EpisodeError,
+    EvaluationResult,
+    evaluate,
+    merge_results,
+)
 from shipgym.benchmark.policies import POLICIES, make_policy
 from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS, env_task
 from shipgym.envs.wrappers import ActuatorDelay, SensorNoise
@@ -259,7 +273,76 @@ def _one_thread() -> None:
     torch.set_num_threads(1)
 
 
-def _evaluate_cell(
+#: Ray tasks aimed at per CPU of the cluster when a campaign is split automatically (more
+#: than one, so that CPUs whose tasks end early take further ones).
+TASKS_PER_CPU = 4
+#: Fewest episodes of an automatically sized task (each task makes its env and policy).
+MIN_TASK_EPISODES = 10
+#: Most episodes of an automatically sized task (a task holds its episodes' envs and logs).
+MAX_TASK_EPISODES = 500
+
+
+@dataclass(frozen=True)
+class EpisodeBatch:
+    """Episodes of consecutive seeds of one (env, controller, scenario): one Ray task, or a
+    whole cell before it is split (:meth:`split`).
+
+    ``keep_logs`` is the number of episode logs returned (from the first seed; ``None``: all).
+    The policy is made on the worker from its name, so a batch is a few small values.
+    """
+
+    env_id: str
+    controller: str
+    scenario: Scenario
+    seed: int
+    episodes: int
+    agents_dir: str | None = None
+    keep_logs: int | None = None
+
+    def describe(self) -> str:
+        """``"<env> <controller> (<condition>), seeds a..b"``."""
+        last = self.seed + self.episodes - 1
+        seeds = f"seed {self.seed}" if self.episodes == 1 else f"seeds {self.seed}..{last}"
+        return f"{self.env_id} {self.controller} ({self.scenario.label}), {seeds}"
+
+    def split(self, size: int) -> list[EpisodeBatch]:
+        """This batch as consecutive batches of at most ``size`` episodes, as even as possible,
+        the logs kept from the first seeds."""
+        n = math.ceil(self.episodes / size)
+        base, extra = divmod(self.episodes, n)
+        parts, offset = [], 0
+        for k in range(n):
+            count = base + (k < extra)
+            keep = None if self.keep_logs is None else max(0, min(count, self.keep_logs - offset))
+            parts.append(replace(self, seed=self.seed + offset, episodes=count, keep_logs=keep))
+            offset += count
+        return parts
+
+    def run(self) -> EvaluationResult:
+        """Evaluate the batch here (on a Ray worker: the task's body)."""
+        result = evaluate(
+            self.env_id,
+            make_policy(self.controller, self.env_id, self.agents_dir),
+            self.controller,
+            episodes=self.episodes,
+            seed=self.seed,
+            env_kwargs=self.scenario.env_kwargs,
+            reset_options=self.scenario.reset_options,
+            progress=lambda line: None,
+            condition=self.scenario.label,
+            wrappers=self.scenario.wrappers,
+        )
+        if self.keep_logs is not None:
+            result.logs = result.logs[: self.keep_logs]
+        return result
+
+
+def _run_batch(batch: EpisodeBatch) -> EvaluationResult:
+    """The Ray task: :meth:`EpisodeBatch.run`."""
+    return batch.run()
+
+
+def _cell_batch(
     env_id: str,
     condition: str,
     label: str,
@@ -269,24 +352,166 @@ def _evaluate_cell(
     seed: int,
     agents_dir: str | Path | None,
     keep_logs: int | None,
-) -> EvaluationResult:
-    """One benchmark cell: ``name`` on the ``label`` scenario of ``condition`` on ``env_id``
-    (the policy is made here, so that a worker process needs nothing but these arguments)."""
+) -> EpisodeBatch:
+    """The benchmark cell ``name`` on the ``label`` scenario of ``condition`` on ``env_id``."""
     scenario = next(s for s in scenarios(env_id, condition, stress) if s.label == label)
-    result = evaluate(
+    agents = None if agents_dir is None else str(agents_dir)
+    return EpisodeBatch(env_id, name, scenario, seed, episodes, agents, keep_logs)
+
+
+def _evaluate_cell(*cell: Any) -> EvaluationResult:
+    """One benchmark cell, evaluated here (the arguments of :func:`_cell_batch`: names and
+    numbers, so that a spawned worker process needs nothing else)."""
+    return _cell_batch(*cell).run()
+
+
+def task_episodes(total: int, cpus: int) -> int:
+    """Episodes per task for a campaign of ``total`` episodes on ``cpus`` CPUs: about
+    :data:`TASKS_PER_CPU` tasks per CPU, within [:data:`MIN_TASK_EPISODES`,
+    :data:`MAX_TASK_EPISODES`]."""
+    return min(MAX_TASK_EPISODES, max(MIN_TASK_EPISODES, math.ceil(total / (TASKS_PER_CPU * cpus))))
+
+
+def run_on_ray(
+    cells: Sequence[EpisodeBatch],
+    address: str | None = None,
+    num_cpus: int | None = None,
+    task_size: int | None = None,
+    progress: Callable[[str], None] | None = None,
+    on_cell: Callable[[EvaluationResult, float], None] | None = None,
+) -> list[EvaluationResult]:
+    """Evaluate ``cells`` as Ray tasks of at most ``task_size`` episodes each.
+
+    Parameters
+    ----------
+    cells : sequence of EpisodeBatch
+        The evaluations (one per env, controller and scenario, over all their seeds).
+    address : str, optional
+        Ray cluster to join (``host:port``, ``ray://host:port``, ``"auto"``); ``None`` starts
+        Ray on this machine (see :func:`shipgym.cluster.ray_session`).
+    num_cpus : int, optional
+        CPUs of a local Ray (default: every core).
+    task_size : int, optional
+        Episodes per task (default: :func:`task_episodes` of the campaign on the cluster's
+        CPUs). The results do not depend on it.
+    progress : callable, optional
+        Called with a line per finished task (default: print to stderr).
+    on_cell : callable, optional
+        Called with each cell's merged result and the seconds since the start when its last
+        task finishes.
+
+    Returns
+    -------
+    list of EvaluationResult
+        One per cell, in the order of ``cells``; equal to :func:`evaluate` of each cell.
+
+    Raises
+    ------
+    EpisodeError
+        An episode raised on a worker (names the env, controller, condition and seed).
+    shipgym.cluster.ClusterTaskError
+        A task failed otherwise (its policy could not be made, its worker died); names the
+        env, controller, condition and seeds of the task.
+    """
+    from shipgym.cluster import cluster_cpus, ray_session, run_tasks
+
+    if task_size is not None and (
+        isinstance(task_size, bool) or not isinstance(task_size, int) or task_size < 1
+    ):
+        raise ValueError(f"task_size must be an integer >= 1 episodes, got {task_size!r}")
+    if progress is None:
+
+        def progress(line: str) -> None:
+            print(line, file=sys.stderr, flush=True)
+
+    with ray_session(address, num_cpus) as ray:
+        cpus = cluster_cpus()
+        size = task_size or task_episodes(sum(c.episodes for c in cells), cpus)
+        tasks = [(i, part) for i, cell in enumerate(cells) for part in cell.split(size)]
+        left = [0] * len(cells)
+        for i, _ in tasks:
+            left[i] += 1
+        parts: list[list[EvaluationResult]] = [[] for _ in cells]
+        merged: list[EvaluationResult | None] = [None] * len(cells)
+        where = "local Ray" if address is None else f"Ray cluster {address}"
+        progress(
+            f"{len(tasks)} Ray tasks of up to {size} episodes for {len(cells)} evaluation(s) on "
+            f"the {where} ({cpus} CPUs, {ray.__version__})"
+        )
+        t0 = time.perf_counter()
+        finished = 0
+
+        def done(k: int, result: EvaluationResult) -> None:
+            nonlocal finished
+            finished += 1
+            i, batch = tasks[k]
+            seconds = time.perf_counter() - t0
+            progress(f"[{finished}/{len(tasks)} tasks, {seconds:.1f} s] {batch.describe()} done")
+            parts[i].append(result)
+            left[i] -= 1
+            if left[i] == 0:
+                merged[i] = merge_results(parts[i])
+                if on_cell is not None:
+                    on_cell(merged[i], seconds)
+
+        run_tasks(
+            _run_batch,
+            [batch for _, batch in tasks],
+            describe=EpisodeBatch.describe,
+            on_done=done,
+            passthrough=(EpisodeError,),
+        )
+    return [m for m in merged if m is not None]
+
+
+def evaluate_on_ray(
+    env_id: str,
+    controller: str,
+    episodes: int = 10,
+    seed: int = 0,
+    *,
+    address: str | None = None,
+    num_cpus: int | None = None,
+    task_size: int | None = None,
+    env_kwargs: dict[str, Any] | None = None,
+    reset_options: dict[str, Any] | None = None,
+    condition: str = "nominal",
+    wrappers: Sequence[Callable[[gym.Env], gym.Env]] = (),
+    agents_dir: str | Path | None = None,
+    keep_logs: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> EvaluationResult:
+    """:func:`~shipgym.benchmark.evaluate.evaluate` of the controller ``controller`` (one of
+    :data:`~shipgym.benchmark.policies.POLICIES`) split into Ray tasks; the same result.
+
+    ``address``, ``num_cpus``, ``task_size`` and ``progress`` are those of :func:`run_on_ray`;
+    the other parameters those of :func:`~shipgym.benchmark.evaluate.evaluate` (``wrappers``
+    are sent to the workers, so they must pickle: classes and functions, also local ones).
+    ``keep_logs`` episode logs come back (``None``: all; the per-episode values always do).
+
+    Raises
+    ------
+    ValueError
+        An unknown env or controller or a bad count, before Ray starts.
+    EpisodeError, shipgym.cluster.ClusterTaskError
+        As :func:`run_on_ray`.
+    """
+    if env_id not in ENV_IDS:
+        raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    if controller not in POLICIES:
+        raise ValueError(f"unknown controller {controller!r}; expected one of {POLICIES}")
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    cell = EpisodeBatch(
         env_id,
-        make_policy(name, env_id, agents_dir),
-        name,
-        episodes=episodes,
-        seed=seed,
-        env_kwargs=scenario.env_kwargs,
-        reset_options=scenario.reset_options,
-        progress=lambda line: None,
-        condition=label,
-        wrappers=scenario.wrappers,
+        controller,
+        Scenario(condition, env_kwargs, reset_options, tuple(wrappers)),
+        seed,
+        episodes,
+        None if agents_dir is None else str(agents_dir),
+        keep_logs,
     )
-    if keep_logs is not None:
-        result.logs = result.logs[:keep_logs]
+    (result,) = run_on_ray([cell], address, num_cpus, task_size, progress)
     return result
 
 
@@ -300,6 +525,9 @@ def run_benchmark(
     progress: Callable[[str], None] | None = None,
     jobs: int | None = None,
     keep_logs: int | None = 1,
+    ray: bool | str = False,
+    ray_cpus: int | None = None,
+    task_size: int | None = None,
 ) -> BenchmarkResult:
     """Evaluate ``controllers`` on ``envs`` under ``conditions`` on identical seeds.
 
@@ -317,10 +545,18 @@ def run_benchmark(
         Called with a line per finished evaluation (default: print to stderr).
     jobs : int, optional
         Evaluations run at once, each in its own process (default: one per core); 1 runs
-        them in this process. The results are the same either way.
+        them in this process. The results are the same either way. Not with ``ray``.
     keep_logs : int or None
         Episode logs kept per evaluation (1: the first, for the trajectory figures; ``None``:
         all). The metrics and per-episode values are kept for every episode regardless.
+    ray : bool or str
+        Run the episodes as Ray tasks (:func:`run_on_ray`) instead of local processes:
+        ``True`` or ``"local"`` starts Ray on this machine, ``"host:port"`` (or
+        ``"ray://host:port"``, ``"auto"``) joins that cluster. The results are the same.
+    ray_cpus : int, optional
+        CPUs of a local Ray (default: every core).
+    task_size : int, optional
+        Episodes per Ray task (default: about four tasks per CPU of the cluster).
 
     Returns
     -------
@@ -336,6 +572,18 @@ def run_benchmark(
         bad = [g for g in given if g not in allowed]
         if bad or not given:
             raise ValueError(f"unknown {name}(s) {bad or given!r}; expected some of {allowed}")
+    address: str | None = None
+    if ray is not False:
+        from shipgym.cluster import parse_address
+
+        if jobs is not None:
+            raise ValueError(
+                f"jobs={jobs!r} sets the local process pool; with ray the Ray cluster's CPUs run "
+                "the episodes (ray_cpus for a local Ray)"
+            )
+        address = None if ray is True else parse_address(ray)
+        if address is not None and ray_cpus is not None:
+            raise ValueError("ray_cpus is for a local Ray only; a cluster has its own CPUs")
     jobs = (os.cpu_count() or 1) if jobs is None else jobs
     if not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
@@ -382,7 +630,11 @@ def run_benchmark(
             f"return {_cell(result, 'return')} ({seconds:.1f} s)"
         )
 
-    if jobs == 1:
+    if ray is not False:
+        batches = [_cell_batch(*cell) for cell in cells]
+        in_order = run_on_ray(batches, address, ray_cpus, task_size, progress, on_cell=report)
+        results[:] = in_order  # cell order, as the local run gives them
+    elif jobs == 1:
         for cell in cells:
             t0 = time.perf_counter()
             report(_evaluate_cell(*cell), time.perf_counter() - t0)
