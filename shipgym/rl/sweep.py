@@ -28,6 +28,7 @@ import io
 import itertools
 import json
 import math
+import os
 import shutil
 import time
 from collections.abc import Callable, Sequence
@@ -197,6 +198,17 @@ class SweepSpec:
         }
 
 
+def _as_number(value: Any) -> Any:
+    """``value`` as a float if it is text that reads as a finite number, else unchanged."""
+    if isinstance(value, str):
+        try:
+            number = float(value)
+        except ValueError:
+            return value
+        return number if math.isfinite(number) else value
+    return value
+
+
 def _read_file(path: Path) -> dict[str, Any]:
     try:
         text = path.read_text()
@@ -270,13 +282,14 @@ def load_sweep(
     data = {} if path is None else _read_file(Path(path))
 
     def listed(key: str, allowed: Sequence[str], flag: Any) -> list[str]:
-        value = _pick(where, key, data.get(key), flag)
-        values = value if isinstance(value, list) else [value]
+        given = data.get(key)
+        for v in given if isinstance(given, list) else [given]:
+            if given is not None and (not isinstance(v, str) or v not in allowed):
+                raise ValueError(f"{where}: {key} {v!r} is not one of {', '.join(allowed)}")
+        value = _pick(where, key, given, flag)
         if value is None:
             raise ValueError(f"{where}: no {key} (give '{key}:' in the file or --{key})")
-        for v in values:
-            if v not in allowed:
-                raise ValueError(f"{where}: {key} {v!r} is not one of {', '.join(allowed)}")
+        values = value if isinstance(value, list) else [value]
         if not values or len(set(values)) != len(values):
             raise ValueError(f"{where}: {key} must list distinct values, got {value!r}")
         return list(values)
@@ -316,6 +329,8 @@ def load_sweep(
             choices = value if isinstance(value, list) else [value]
         if not choices:
             raise ValueError(f"{where}: {key} lists no choice")
+        if kind not in (_COUNT, _COUNT0, _LAYERS):  # YAML 1.1 reads 1e-4 (no dot) as text
+            choices = [_as_number(c) for c in choices]
         for choice in choices:
             if not kind.check(choice):
                 raise ValueError(
@@ -474,11 +489,12 @@ class SweepResult:
         """The summary as printable lines (best trial of each agent first)."""
         head = ("trial", "agent", "hyperparameters", "steps", "best return (step)", "final",
                 "wall [s]", "resumed at", "status")  # fmt: skip
+        varying = _varying(self.rows)
         body = [
             (
                 row["trial"],
                 row["agent"],
-                _short(row["hyperparameters"]) or "defaults",
+                _short(row["hyperparameters"], varying) or "-",
                 _fmt_int(row["timesteps"]),
                 "-"
                 if row["best_validation_return"] is None
@@ -505,8 +521,20 @@ def _fmt_int(value: Any) -> str:
     return "-" if value is None else f"{int(value):,}"
 
 
-def _short(params: dict[str, Any]) -> str:
-    return " ".join(f"{k}={json.dumps(v).replace(' ', '')}" for k, v in params.items())
+def _short(params: dict[str, Any], keys: Sequence[str] | None = None) -> str:
+    return " ".join(
+        f"{k}={json.dumps(v).replace(' ', '')}"
+        for k, v in params.items()
+        if keys is None or k in keys
+    )
+
+
+def _varying(rows: list[dict[str, Any]]) -> list[str]:
+    """The hyperparameters whose value differs between the rows (the rest is fixed)."""
+    keys = {k for row in rows for k in row["hyperparameters"]}
+    return sorted(
+        k for k in keys if len({json.dumps(r["hyperparameters"].get(k)) for r in rows}) > 1
+    )
 
 
 def _row(trial: Trial, out: Path, error: str | None) -> dict[str, Any]:
@@ -594,6 +622,7 @@ def learning_curve_figure(rows: list[dict[str, Any]]) -> Any:
     from matplotlib.figure import Figure
 
     agents = sorted({row["agent"] for row in rows})
+    varying = _varying(rows)
     fig = Figure(figsize=(7.0, 3.2 * len(agents)), layout="constrained")
     axes = fig.subplots(len(agents), 1, squeeze=False)[:, 0]
     styles = ["-", "--", ":", "-."]
@@ -604,7 +633,7 @@ def learning_curve_figure(rows: list[dict[str, Any]]) -> Any:
             curve = row["learning_curve"]
             steps = np.asarray(curve["timesteps"], dtype=float)
             values = np.asarray(curve["mean_return"], dtype=float)
-            label = f"{row['trial']} {_short(row['hyperparameters'])}".strip()
+            label = f"{row['trial']} {_short(row['hyperparameters'], varying)}".strip()
             ax.plot(
                 steps,
                 values,
@@ -615,8 +644,15 @@ def learning_curve_figure(rows: list[dict[str, Any]]) -> Any:
             )
             resumed = [i for i, s in enumerate(curve["timesteps"]) if s in row["resumed_at"]]
             if resumed:
-                ax.plot(steps[resumed], values[resumed], "o", mfc="none", ms=10,
-                        color=colours[row["config"]])  # fmt: skip
+                ax.plot(
+                    steps[resumed],
+                    values[resumed],
+                    "o",
+                    mfc="none",
+                    ms=10,
+                    color=colours[row["config"]],
+                    label=f"{row['trial']} resumed from its checkpoint",
+                )
         ax.set_title(agent)
         ax.set_xlabel("environment steps")
         ax.set_ylabel("validation return")
@@ -670,7 +706,7 @@ def _progress_callback(progress: Callable[[str], None] | None, total: int) -> An
         def on_trial_result(
             self, iteration: int, trials: list, trial: Any, result: dict, **info: Any
         ) -> None:
-            if "timesteps" in result:
+            if "timesteps" in result and not result.get("final"):
                 self._say(
                     f"{trial.config['trial']['label']}: {result['timesteps']} steps, validation "
                     f"return {result['validation_return']:.1f} "
@@ -758,6 +794,9 @@ def run_sweep(
     if progress is not None:
         progress(f"sweep: {len(trials)} trials into {out / 'trials'}")
     errors: dict[str, str] = {}
+    # Tune's classic console output, which verbose=0 silences (the newer one prints a box per
+    # result and a TensorBoard hint into Ray's temporary folder); our progress lines remain
+    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
     with ray_session(address, num_cpus):
         trainable = tune.with_resources(
             tune.with_parameters(_tune_trial, callback_factory=callback_factory), {"cpu": 1}
@@ -821,11 +860,15 @@ def best_trials(sweep_dir: str | Path) -> dict[str, Path]:
     return {name: folder for name, (_, folder) in best.items()}
 
 
-def install_agent(trial_dir: Path, name: str, dest: str | Path, source: str) -> tuple[Path, Path]:
-    """Copy a trial's agent (``<name>.zip``, ``<name>.json``) into ``dest`` atomically; the
-    record gains ``"selected_from"`` (``source``, e.g. the sweep folder and trial)."""
+def install_agent(
+    trial_dir: Path, name: str, dest: str | Path, source: str | None = None
+) -> tuple[Path, Path]:
+    """Copy an agent (``<name>.zip``, ``<name>.json``) from a training's output folder into
+    ``dest`` atomically; with ``source`` (e.g. the sweep folder and trial) the record gains
+    ``"selected_from": source``."""
     record = checkpoints.read_record(trial_dir / f"{name}.json")
-    record["selected_from"] = source
+    if source is not None:
+        record["selected_from"] = source
     text = json.dumps(record, indent=2) + "\n"
     dest = Path(dest)
     zip_path, json_path = dest / f"{name}.zip", dest / f"{name}.json"
