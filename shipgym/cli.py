@@ -140,7 +140,11 @@ def _run_bench(args: argparse.Namespace) -> int:
         flush=True,
     )
     report = run_bench(
-        steps=args.steps, num_envs=args.num_envs, repeats=args.repeats, vec_steps=args.vec_steps
+        steps=args.steps,
+        num_envs=args.num_envs,
+        repeats=args.repeats,
+        vec_steps=args.vec_steps,
+        busy=args.busy,
     )
     print(format_table(report))
     outputs: list[tuple[Path, Callable[[Path], Any]]] = []
@@ -194,6 +198,16 @@ def _build_bench(sub: Any) -> None:
         default=None,
         metavar="N",
         help="timed vector steps per repeat (default: max(5, steps // 200))",
+    )
+    p.add_argument(
+        "--busy",
+        type=_int_in(0, 64),
+        default=0,
+        metavar="N",
+        help=(
+            "run with N helper processes keeping cores busy (a shared machine), to compare the "
+            "one-thread and all-thread vector steps under load (default: %(default)s, idle)"
+        ),
     )
     p.add_argument("--json", default=None, metavar="OUT", help="write the numbers as JSON")
     p.add_argument(
@@ -796,6 +810,7 @@ def _interrupted(out: Path, env_id: str | None, algo: str | None) -> int:
 
 def _run_train(args: argparse.Namespace) -> int:
     import signal
+    import threading
 
     if args.ray is not None or args.sweep is not None or args.seeds is not None:
         return _run_train_sweep(args)
@@ -821,9 +836,21 @@ def _run_train(args: argparse.Namespace) -> int:
     tensorboard = _tensorboard_option(args)
     bar = not args.quiet and sys.stderr.isatty()
     progress = None if (bar or args.quiet) else _progress
-    # SIGTERM (a batch system's stop, kill) ends the run like Ctrl-C: the checkpoints of the
-    # last evaluation stay, and the message says how to continue
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    # the first Ctrl-C or SIGTERM (a batch system's stop, kill) evaluates and checkpoints the
+    # policy of that step and stops; a second one stops at once (the last checkpoint stays)
+    stop = threading.Event()
+
+    def on_signal(signum: int, frame: Any) -> None:
+        if stop.is_set():
+            raise KeyboardInterrupt
+        stop.set()
+        print(
+            f"{PROG}: stopping: saving the policy of this step (interrupt again to stop at once)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         if args.resume is not None:
             from shipgym.rl.train import resume
@@ -836,6 +863,7 @@ def _run_train(args: argparse.Namespace) -> int:
                 progress_bar=bar,
                 progress=_progress if not args.quiet else None,
                 tensorboard_log=tensorboard,
+                stop=stop,
             )
         else:
             from shipgym.rl.train import config, train
@@ -860,11 +888,13 @@ def _run_train(args: argparse.Namespace) -> int:
                 progress=progress,
                 tensorboard_log=tensorboard,
                 overwrite=args.overwrite,
+                stop=stop,
             )
     except KeyboardInterrupt:
         return _interrupted(out, args.env, args.algo)
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     meta = result.meta
     print(
         f"{meta['name']}: {meta['timesteps']} steps in {meta['wall_time_s']:.0f} s "

@@ -219,8 +219,11 @@ def test_sigterm_stops_the_command_with_its_checkpoint_and_resume_finishes_it(
     err = capsys.readouterr().err
     assert code == 130
     assert f"shipgym train --resume {out}" in err
-    done = json.loads(record.read_text())["timesteps"]
-    assert 128 <= done < 1_000_000
+    # the signal stopped the run at the next step, after evaluating and saving its policy
+    saved = json.loads(record.read_text())
+    done = saved["timesteps"]
+    assert 128 < done < 1_000_000 and saved["learning_curve"]["timesteps"][-1] == done
+    assert "stopping: saving the policy of this step" in err
     load_agent(ENV, "ppo", out)  # the partial agent is usable
     # a fresh run into the folder would wipe it: refused
     assert main(argv) == 2

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import os
 import platform
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -209,8 +210,11 @@ class _Run:
         on_evaluation: Callable[[dict[str, Any]], None] | None,
         verbose: int,
         best: dict[str, Any] | None = None,
+        stop: threading.Event | None = None,
     ) -> None:
         self.out = out
+        self.stop = stop
+        self.stopped = False
         self.record = record
         self.name = record["name"]
         self.algo = record["algo"]
@@ -327,6 +331,10 @@ class _Run:
 
         class _Evaluations(BaseCallback):
             def _on_step(self) -> bool:
+                if run.stop is not None and run.stop.is_set():
+                    run.evaluate()  # score and checkpoint the policy of this step, then stop
+                    run.stopped = True
+                    return False
                 if self.num_timesteps >= run.next_eval:
                     run.evaluate()
                 return True
@@ -345,12 +353,15 @@ class _Run:
                 progress_bar=progress_bar,
                 reset_num_timesteps=fresh,
             )
-            # a final evaluation (unless one fell on the last step), so the end can win too
-            self.evaluate(final=True)
+            if not self.stopped:
+                # a final evaluation (unless one fell on the last step), so the end can win too
+                self.evaluate(final=True)
         finally:
             self.logger.close()
             self.venv.close()
             self.eval_env.close()
+        if self.stopped:
+            raise KeyboardInterrupt(f"{self.name}: stopped at step {self.model.num_timesteps}")
         meta = self.snapshot(False, self.best["obs"])
         checkpoints.write_final_record(self.out, self.name, meta)
         return TrainResult(
@@ -426,6 +437,7 @@ def train(
     overwrite: bool = False,
     callbacks: Sequence[Any] = (),
     on_evaluation: Callable[[dict[str, Any]], None] | None = None,
+    stop: threading.Event | None = None,
 ) -> TrainResult:
     """Train a PPO or SAC agent on ``env_id``, checkpointing the best and the latest policy.
 
@@ -478,10 +490,20 @@ def train(
     on_evaluation : callable, optional
         Called with ``{"timesteps", "validation_return", "best_validation_return",
         "best_timestep", "final"}`` after every evaluation (e.g. to report to Ray Tune).
+    stop : threading.Event, optional
+        When set (e.g. by a signal handler), the training evaluates and checkpoints the
+        policy of the current step, then raises ``KeyboardInterrupt``: a stop that loses
+        nothing, at a step where the model is consistent.
 
     Returns
     -------
     TrainResult
+
+    Raises
+    ------
+    KeyboardInterrupt
+        On an interrupt, or after a ``stop``; the checkpoints stay (continue with
+        :func:`resume`).
     """
     from stable_baselines3 import PPO, SAC
 
@@ -550,7 +572,9 @@ def train(
         "versions": _versions(),
         "machine": _machine(),
     }
-    run = _Run(out, record, model, venv, eval_env, tb_root, progress, on_evaluation, verbose)
+    run = _Run(
+        out, record, model, venv, eval_env, tb_root, progress, on_evaluation, verbose, stop=stop
+    )
     return run.learn(callbacks, progress_bar, fresh=True)
 
 
@@ -572,6 +596,7 @@ def resume(
     tensorboard_log: str | Path | bool = True,
     callbacks: Sequence[Any] = (),
     on_evaluation: Callable[[dict[str, Any]], None] | None = None,
+    stop: threading.Event | None = None,
 ) -> TrainResult:
     """Continue the training in ``out_dir`` from its latest checkpoint.
 
@@ -591,7 +616,7 @@ def resume(
     timesteps : int, optional
         The new total of environment steps (default: the record's ``requested_timesteps``);
         must exceed the steps done.
-    progress_bar, progress, verbose, tensorboard_log, callbacks, on_evaluation
+    progress_bar, progress, verbose, tensorboard_log, callbacks, on_evaluation, stop
         As in :func:`train`.
 
     Returns
@@ -668,6 +693,16 @@ def resume(
     if progress is not None:
         progress(f"{name}: resuming at step {steps} of {total} from {folder}")
     run = _Run(
-        out, record, model, venv, eval_env, tb_root, progress, on_evaluation, verbose, best=best
+        out,
+        record,
+        model,
+        venv,
+        eval_env,
+        tb_root,
+        progress,
+        on_evaluation,
+        verbose,
+        best=best,
+        stop=stop,
     )
     return run.learn(callbacks, progress_bar, fresh=False)
