@@ -2,11 +2,12 @@
 
 One kernel per task family, looping over the rows of a batch. The single environment calls
 it with one row and the vector environment with many, so both run the same code and the same
-physics (:func:`shipgym.models.integrate.rk4_row`, inlined). Each kernel loops over chunks of
-rows and, for each row, maps the action, integrates, and computes the observation, reward and
-termination while the row is in cache. Each is compiled twice from one source: serially for
-small batches and with a ``prange`` loop over chunks for large ones (``PARALLEL_MIN_ROWS``);
-both give bit-identical results. Conventions: NED, heading clockwise from north, SI units and
+physics (:func:`shipgym.models.integrate.rk4_block`). Each kernel loops over chunks of rows;
+within a chunk it maps the actions and integrates a block of rows at once (the SIMD block
+step), then computes each row's observation, reward and termination while the block is in
+cache. Each is compiled twice from one source: serially and with a ``prange`` loop over
+chunks, which the vector env runs on ``num_threads`` threads; both give bit-identical
+results. Conventions: NED, heading clockwise from north, SI units and
 radians; the normalised action ``a`` is clipped to [-1, 1] and mapped to the model input by
 ``u = u0 + B a``.
 
@@ -31,7 +32,7 @@ from numba import prange
 
 from shipgym.models._jit import kernel, parallel_kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import rk4_row
+from shipgym.models.integrate import BLOCK, block_work, gather_rows, rk4_block, scatter_rows
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
@@ -64,15 +65,20 @@ def _map_action(a, u0, B, u, i):
 
 
 @row_kernel
-def _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work):
-    """Map row ``i``'s action to inputs, count the step and take one RK4 step.
+def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
+    """Map the actions of rows ``rows[start .. start + n - 1]`` to inputs, count their step
+    and take one RK4 step of the block (:func:`~shipgym.models.integrate.rk4_block`).
 
-    ``work`` is a tuple of five scratch vectors for :func:`rk4_row`.
+    ``work`` is one block's work arrays (:func:`~shipgym.models.integrate.block_work`).
     """
-    _map_action(a, u0, B, u, i)
-    steps[i] += 1
-    k1, k2, k3, k4, t = work
-    rk4_row(model_id, x, u, p, c, dt, i, k1, k2, k3, k4, t)
+    for j in range(start, start + n):
+        i = rows[j]
+        _map_action(a, u0, B, u, i)
+        steps[i] += 1
+    XB, UB, CB, W = work
+    gather_rows(x, u, c, rows, start, n, XB, UB, CB)
+    rk4_block(model_id, XB, UB, p, CB, dt, n, W)
+    scatter_rows(XB, rows, start, n, x)
 
 
 @row_kernel
@@ -161,22 +167,25 @@ def _heading(
     n_sp = schedule.shape[1]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        scratch = np.empty((5, x.shape[1]))
-        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        work = block_work(x.shape[1], u.shape[1])
         prev = np.empty(obs.shape[1])
-        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
-            i = rows[j]
+        lo = chunk * CHUNK
+        hi = min(n_rows, lo + CHUNK)
+        for start in range(lo, hi, BLOCK):
+            m = min(BLOCK, hi - start)
             if advance:
-                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
-            if _begin_row(x, i, rew, term, reason):
-                _keep_obs(obs, i, prev)
-                psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-                e = ssa_scalar(psi_d - x[i, ipsi])
-                obs[i, 0] = e
-                for k in range(obs_idx.shape[0]):
-                    obs[i, 1 + k] = x[i, obs_idx[k]]
-                rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
-                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            for j in range(start, start + m):
+                i = rows[j]
+                if _begin_row(x, i, rew, term, reason):
+                    _keep_obs(obs, i, prev)
+                    psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                    e = ssa_scalar(psi_d - x[i, ipsi])
+                    obs[i, 0] = e
+                    for k in range(obs_idx.shape[0]):
+                        obs[i, 1 + k] = x[i, obs_idx[k]]
+                    rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
+                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -216,27 +225,30 @@ def _speed(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        scratch = np.empty((5, x.shape[1]))
-        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        work = block_work(x.shape[1], u.shape[1])
         prev = np.empty(obs.shape[1])
-        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
-            i = rows[j]
+        lo = chunk * CHUNK
+        hi = min(n_rows, lo + CHUNK)
+        for start in range(lo, hi, BLOCK):
+            m = min(BLOCK, hi - start)
             if advance:
-                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
-            if _begin_row(x, i, rew, term, reason):
-                _keep_obs(obs, i, prev)
-                psi = x[i, 2]
-                ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
-                ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-                frac = x[i, 6] / tb
-                obs[i, 0] = ud - ur
-                obs[i, 1] = ur
-                obs[i, 2] = frac
-                obs[i, 3] = ud
-                e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
-                f = min(max(frac, obs_lo[2]), obs_hi[2])
-                rew[i] = -abs(e) / 2.0 - 0.05 * f * f
-                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            for j in range(start, start + m):
+                i = rows[j]
+                if _begin_row(x, i, rew, term, reason):
+                    _keep_obs(obs, i, prev)
+                    psi = x[i, 2]
+                    ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
+                    ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                    frac = x[i, 6] / tb
+                    obs[i, 0] = ud - ur
+                    obs[i, 1] = ur
+                    obs[i, 2] = frac
+                    obs[i, 3] = ud
+                    e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
+                    f = min(max(frac, obs_lo[2]), obs_hi[2])
+                    rew[i] = -abs(e) / 2.0 - 0.05 * f * f
+                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -301,53 +313,60 @@ def _path(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        scratch = np.empty((5, x.shape[1]))
-        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        work = block_work(x.shape[1], u.shape[1])
         prev = np.empty(obs.shape[1])
-        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
-            i = rows[j]
-            s_before = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
+        s_before = np.empty(BLOCK)
+        lo = chunk * CHUNK
+        hi = min(n_rows, lo + CHUNK)
+        for start in range(lo, hi, BLOCK):
+            m = min(BLOCK, hi - start)
+            for j in range(start, start + m):  # along-track distance left before the step
+                i = rows[j]
+                s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
+                s_before[j - start] = s_left
             if advance:
-                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
-            if _begin_row(x, i, rew, term, reason):
-                _keep_obs(obs, i, prev)
-                e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                progress = s_before - s_left
-                k = seg[i]
-                dist_end = math.hypot(
-                    x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
-                )
-                bonus = 0.0
-                if dist_end < accept_radius or s_left < 0.0:
-                    if k + 2 < n_wp[i]:
-                        seg[i] = k + 1
-                        e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                    else:
+                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            for j in range(start, start + m):
+                i = rows[j]
+                if _begin_row(x, i, rew, term, reason):
+                    _keep_obs(obs, i, prev)
+                    e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+                    progress = s_before[j - start] - s_left
+                    k = seg[i]
+                    dist_end = math.hypot(
+                        x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
+                    )
+                    bonus = 0.0
+                    if dist_end < accept_radius or s_left < 0.0:
+                        if k + 2 < n_wp[i]:
+                            seg[i] = k + 1
+                            e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
+                        else:
+                            term[i] = True
+                            reason[i] = SUCCESS
+                            bonus = 20.0
+                    if abs(e) > max_cross_track:
                         term[i] = True
-                        reason[i] = SUCCESS
-                        bonus = 20.0
-                if abs(e) > max_cross_track:
-                    term[i] = True
-                    reason[i] = FAILURE
-                    bonus = -20.0
-                chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
-                obs[i, 0] = e
-                obs[i, 1] = chi_err
-                obs[i, 2] = s_left
-                obs[i, 3] = turn[i, seg[i]]
-                obs[i, 4] = x[i, 3]
-                obs[i, 5] = x[i, 4]
-                obs[i, 6] = x[i, 5]
-                obs[i, 7] = x[i, 8]
-                obs[i, 8] = x[i, 6] / tb
-                rew[i] = (
-                    0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
-                    + 0.5 * math.exp(-((e / 25.0) ** 2))
-                    - 0.1 * abs(chi_err) / math.pi
-                    - 0.05 * _action_cost(a, i)
-                    + bonus
-                )
-                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                        reason[i] = FAILURE
+                        bonus = -20.0
+                    chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
+                    obs[i, 0] = e
+                    obs[i, 1] = chi_err
+                    obs[i, 2] = s_left
+                    obs[i, 3] = turn[i, seg[i]]
+                    obs[i, 4] = x[i, 3]
+                    obs[i, 5] = x[i, 4]
+                    obs[i, 6] = x[i, 5]
+                    obs[i, 7] = x[i, 8]
+                    obs[i, 8] = x[i, 6] / tb
+                    rew[i] = (
+                        0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
+                        + 0.5 * math.exp(-((e / 25.0) ** 2))
+                        - 0.1 * abs(chi_err) / math.pi
+                        - 0.05 * _action_cost(a, i)
+                        + bonus
+                    )
+                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -389,44 +408,48 @@ def _target(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        scratch = np.empty((5, x.shape[1]))
-        work = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4])
+        work = block_work(x.shape[1], u.shape[1])
         prev = np.empty(obs.shape[1])
-        for j in range(chunk * CHUNK, min(n_rows, (chunk + 1) * CHUNK)):
-            i = rows[j]
+        lo = chunk * CHUNK
+        hi = min(n_rows, lo + CHUNK)
+        for start in range(lo, hi, BLOCK):
+            m = min(BLOCK, hi - start)
             if advance:
-                _advance_row(model_id, x, u, p, c, dt, a, u0, B, steps, i, work)
-                target[i, 0] += target_vel[i, 0] * dt
-                target[i, 1] += target_vel[i, 1] * dt
-            if _begin_row(x, i, rew, term, reason):
-                _keep_obs(obs, i, prev)
-                psi = x[i, 2]
-                cs = math.cos(psi)
-                sn = math.sin(psi)
-                dn = target[i, 0] - x[i, 0]
-                de = target[i, 1] - x[i, 1]
-                vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
-                ve = sn * x[i, 3] + cs * x[i, 4]
-                rvn = target_vel[i, 0] - vn
-                rve = target_vel[i, 1] - ve
-                d = math.hypot(dn, de)
-                err = d - distance[i]
-                obs[i, 0] = cs * dn + sn * de
-                obs[i, 1] = -sn * dn + cs * de
-                obs[i, 2] = cs * rvn + sn * rve
-                obs[i, 3] = -sn * rvn + cs * rve
-                obs[i, 4] = err
-                obs[i, 5] = x[i, 3]
-                obs[i, 6] = x[i, 4]
-                obs[i, 7] = x[i, 5]
-                obs[i, 8] = x[i, 8]
-                obs[i, 9] = x[i, 6] / tb
-                rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
-                if d > max_distance:
-                    term[i] = True
-                    reason[i] = FAILURE
-                    rew[i] -= 20.0
-                _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            for j in range(start, start + m):
+                i = rows[j]
+                if advance:
+                    target[i, 0] += target_vel[i, 0] * dt
+                    target[i, 1] += target_vel[i, 1] * dt
+                if _begin_row(x, i, rew, term, reason):
+                    _keep_obs(obs, i, prev)
+                    psi = x[i, 2]
+                    cs = math.cos(psi)
+                    sn = math.sin(psi)
+                    dn = target[i, 0] - x[i, 0]
+                    de = target[i, 1] - x[i, 1]
+                    vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
+                    ve = sn * x[i, 3] + cs * x[i, 4]
+                    rvn = target_vel[i, 0] - vn
+                    rve = target_vel[i, 1] - ve
+                    d = math.hypot(dn, de)
+                    err = d - distance[i]
+                    obs[i, 0] = cs * dn + sn * de
+                    obs[i, 1] = -sn * dn + cs * de
+                    obs[i, 2] = cs * rvn + sn * rve
+                    obs[i, 3] = -sn * rvn + cs * rve
+                    obs[i, 4] = err
+                    obs[i, 5] = x[i, 3]
+                    obs[i, 6] = x[i, 4]
+                    obs[i, 7] = x[i, 5]
+                    obs[i, 8] = x[i, 8]
+                    obs[i, 9] = x[i, 6] / tb
+                    rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
+                    if d > max_distance:
+                        term[i] = True
+                        reason[i] = FAILURE
+                        rew[i] -= 20.0
+                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 

@@ -29,12 +29,19 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
+import llvmlite.binding as llvm
 import numba
 from numba.core.caching import FunctionCache
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 _CACHE = os.environ.get("SHIPGYM_NO_CACHE", "") in ("", "0")
+
+# LLVM vectorises a loop whose arrays may overlap only behind run-time overlap checks, and gives
+# up beyond 128 of them. The loop over a block of ships reads and writes one array per state
+# row, which needs more (checked once per block, a few ns); the limit is raised for the
+# process. It changes which loops are vectorised, never a result.
+llvm.set_option("", "-vectorize-memory-check-threshold=4096")
 
 
 def _cache_dir() -> str:
@@ -119,6 +126,17 @@ def kernel(func: F) -> F:
 def row_kernel(func: F) -> F:
     """Compile a per-ship kernel that Numba inlines into the batch loops that call it."""
     return _compile(func, nogil=True, error_model="numpy", inline="always")
+
+
+def simd_kernel(func: F) -> F:
+    """Compile a per-ship model function that the compiler inlines into the loops over a block
+    of ships and turns into SIMD code.
+
+    Inlined by LLVM (``forceinline``), not by Numba: Numba's inlining would add reference
+    counting of the array arguments inside the loop over the ships, which keeps LLVM from
+    vectorising it.
+    """
+    return _compile(func, nogil=True, error_model="numpy", forceinline=True)
 
 
 def parallel_kernel(func: F) -> F:

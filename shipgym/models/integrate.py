@@ -2,25 +2,31 @@
 
 ``rhs(model_id, x, u, p, c, out)`` evaluates the batched state derivative
 ``x' = f(x, u, p, c)`` for a batch of ships (``x`` of shape ``(n, nx)``, ``u`` of shape
-``(n, nu)``, ``c`` the ``(n, 2)`` north/east current) by calling the model's per-ship kernel.
+``(n, nu)``, ``c`` the ``(n, 2)`` north/east current) with the model's one derivative.
 ``rk4_step`` advances the batch in place by one classic fourth-order Runge-Kutta step with
 the input and current held over the step (seed 001 eq. 2). Every user of a model, the
 environments, the manoeuvres and identification, integrates through their compiled kernels
-(``rhs_kernel``, ``rk4_step_kernel``, ``rk4_row``); ``rhs`` and ``rk4_step`` are the same
-kernels behind argument checks, for calls from Python.
+(``rhs_kernel``, ``rk4_step_kernel``, ``rk4_block``, ``rk4_row``); ``rhs`` and ``rk4_step``
+are the same kernels behind argument checks, for calls from Python.
 
-Both run ship by ship through ``rk4_stages``, whose four stages use small work vectors that
-stay in the CPU cache; the environments' kernels call ``rk4_row`` (the same stages over the
-environment models' derivative ``row_rhs``) inside their own row loops, so they do not compile
-the 3-DOF model-test models (MMG, VMM), which no environment uses (it would add 40 % to their
-compile time).
+Block kernels
+-------------
+The environment models (the Nomoto family and the R/V Gunnerus) are stepped a block of ships at
+a time (:data:`BLOCK` ships, states x ships, :func:`rk4_block`): each model's derivative is one
+per-ship function of a column of the block (``nomoto1_col``, ..., ``rvg_col``), written as
+straight-line code with the sine, cosine and arctangent of :mod:`shipgym.models.vmath`, and the
+loop over the ships of a block compiles to SIMD instructions. The model is chosen once per
+block (:func:`block_rhs`), not once per ship and stage. One ship is a block of one
+(:func:`rk4_row`, the identification's replays), so every user of a model runs the same
+function and a ship's result does not depend on the batch it is in. The model-test models
+(MMG, VMM), which no environment uses, keep their per-ship functions and :func:`rk4_stages`.
 
 Checked and unchecked entry points
 ----------------------------------
 Numba does no bounds checking. ``rhs`` and ``rk4_step`` are the Python entry points: they check
 the model id, the rows and columns of every array against the model, the parameter vector's
 length and that everything is finite, then call the compiled ``rhs_kernel`` and
-``rk4_step_kernel``. Those, and the per-ship ``row_rhs``, ``rk4_stages`` and ``rk4_row``, take
+``rk4_step_kernel``. Those, and the block and per-ship functions, take
 their arguments as they are: they are for compiled callers and for code that has already
 checked the arrays (:class:`shipgym.models.ShipModel`).
 
@@ -45,8 +51,8 @@ from shipgym.models import mmg, nomoto, rvg, vmm
 from shipgym.models._checks import real_array, require_finite, shape_error, step_size
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.mmg import mmg_row
-from shipgym.models.nomoto import bech_row, nomoto1_row, nomoto2_row, norrbin_row
-from shipgym.models.rvg import rvg_row
+from shipgym.models.nomoto import bech_col, nomoto1_col, nomoto2_col, norrbin_col
+from shipgym.models.rvg import P_CF, rvg_col, rvg_crossflow_col
 from shipgym.models.vmm import vmm_row
 
 NOMOTO1, NOMOTO2, NORRBIN, BECH, RVG3DOF, KVLCC2, VMM = 0, 1, 2, 3, 4, 5, 6
@@ -73,46 +79,161 @@ _PARAMETER_COUNTS = (
 )  # fmt: skip
 
 
+#: Ships per block of :func:`rk4_block` in the batch kernels (a block's work arrays stay in
+#: the first-level cache; a multiple of the SIMD width).
+BLOCK = 32
+
+
 @row_kernel
-def row_rhs(model_id, x, u, p, c, out):
-    """State derivative of one ship (1-D ``x``, ``u``, ``c``) of an environment model (the
-    Nomoto family and the RVG) written into ``out``."""
+def block_rhs(model_id, X, U, p, C, K, n):
+    """State derivative of ships ``0 .. n-1`` of a block (columns of ``X``, ``U``, ``C``) of an
+    environment model (the Nomoto family and the RVG), written into ``K``.
+
+    The model is chosen once per block; each model's loop over the ships is straight-line
+    code that compiles to SIMD instructions.
+    """
     if model_id == NOMOTO1:
-        nomoto1_row(x, u, p, c, out)
+        for b in range(n):
+            nomoto1_col(X, U, p, C, K, b)
     elif model_id == NOMOTO2:
-        nomoto2_row(x, u, p, c, out)
+        for b in range(n):
+            nomoto2_col(X, U, p, C, K, b)
     elif model_id == NORRBIN:
-        norrbin_row(x, u, p, c, out)
+        for b in range(n):
+            norrbin_col(X, U, p, C, K, b)
     elif model_id == BECH:
-        bech_row(x, u, p, c, out)
+        for b in range(n):
+            bech_col(X, U, p, C, K, b)
     else:
-        rvg_row(x, u, p, c, out)
+        for b in range(n):
+            rvg_col(X, U, p, C, K, b)
+        if p[P_CF] != 0.0:
+            for b in range(n):
+                rvg_crossflow_col(X, p, C, K, b)
 
 
 @row_kernel
-def row_rhs_all(model_id, x, u, p, c, out):
-    """State derivative of one ship of any model: :func:`row_rhs`, the MMG model and the
-    general VMM."""
+def rk4_block(model_id, X, U, p, C, h, n, W):
+    """Advance ships ``0 .. n-1`` of the block ``X`` (states x ships) in place by one classic
+    RK4 step of ``h`` [s] with the inputs ``U`` and current ``C`` held (seed 001 eq. 2).
+
+    ``W`` is scratch of shape ``(3, nx, >= n)``: the slope of a stage, the running sum
+    ``k1 + 2 k2 + 2 k3`` and the stage state. One call site of the derivative for the four
+    stages (compile time and code size grow with every inlined copy of a model), and the same
+    arrays at every stage (a loop over differing arrays does not vectorise as well).
+    """
+    nx = X.shape[0]
+    K = W[0]
+    A = W[1]
+    T = W[2]
+    for j in range(nx):
+        for b in range(n):
+            T[j, b] = X[j, b]
+    for s in range(4):
+        block_rhs(model_id, T, U, p, C, K, n)
+        if s == 0:
+            for j in range(nx):
+                for b in range(n):
+                    A[j, b] = K[j, b]
+                    T[j, b] = X[j, b] + 0.5 * h * K[j, b]
+        elif s < 3:
+            a = h if s == 2 else 0.5 * h
+            for j in range(nx):
+                for b in range(n):
+                    A[j, b] += 2.0 * K[j, b]
+                    T[j, b] = X[j, b] + a * K[j, b]
+        else:
+            for j in range(nx):
+                for b in range(n):
+                    X[j, b] += h / 6.0 * (A[j, b] + K[j, b])
+
+
+@row_kernel
+def block_work(nx, nu):
+    """Work arrays of one block: states, inputs, current (ships as columns) and the RK4
+    scratch of :func:`rk4_block`."""
+    return (
+        np.empty((nx, BLOCK)),
+        np.empty((nu, BLOCK)),
+        np.empty((2, BLOCK)),
+        np.empty((3, nx, BLOCK)),
+    )
+
+
+@row_kernel
+def gather_rows(x, u, c, rows, start, n, XB, UB, CB):
+    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows) into a block."""
+    for b in range(n):
+        i = rows[start + b]
+        for j in range(x.shape[1]):
+            XB[j, b] = x[i, j]
+        for j in range(u.shape[1]):
+            UB[j, b] = u[i, j]
+        CB[0, b] = c[i, 0]
+        CB[1, b] = c[i, 1]
+
+
+@row_kernel
+def scatter_rows(XB, rows, start, n, x):
+    """Copy the block's states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
+    for b in range(n):
+        i = rows[start + b]
+        for j in range(x.shape[1]):
+            x[i, j] = XB[j, b]
+
+
+@row_kernel
+def rk4_row(model_id, x, u, p, c, h, i, work):
+    """:func:`rk4_block` of row ``i`` of ``x`` (an environment model): a block of one ship.
+    ``work`` is scratch of shape ``(3, nx)``. For the identification's replays, which step
+    one ship through a record."""
+    nx = x.shape[1]
+    rk4_block(
+        model_id,
+        x[i].reshape((nx, 1)),
+        u[i].reshape((u.shape[1], 1)),
+        p,
+        c[i].reshape((2, 1)),
+        h,
+        1,
+        work.reshape((3, nx, 1)),
+    )
+
+
+@row_kernel
+def model_test_row(model_id, x, u, p, c, out):
+    """State derivative of one ship (1-D ``x``, ``u``, ``c``) of a model-test model: the MMG
+    model or the general VMM."""
     if model_id == KVLCC2:
         mmg_row(x, u, p, c, out)
-    elif model_id == VMM:
-        vmm_row(x, u, p, c, out)
     else:
-        row_rhs(model_id, x, u, p, c, out)
+        vmm_row(x, u, p, c, out)
 
 
 @kernel
 def rhs_kernel(model_id, x, u, p, c, out):
     """Batched state derivative of model ``model_id``, written into ``out`` (unchecked: see
     :func:`rhs`)."""
-    for i in range(x.shape[0]):
-        row_rhs_all(model_id, x[i], u[i], p, c[i], out[i])
+    n = x.shape[0]
+    if model_id < KVLCC2:
+        rows = np.arange(n)
+        XB, UB, CB, W = block_work(x.shape[1], u.shape[1])
+        KB = W[0]
+        for start in range(0, n, BLOCK):
+            m = min(BLOCK, n - start)
+            gather_rows(x, u, c, rows, start, m, XB, UB, CB)
+            block_rhs(model_id, XB, UB, p, CB, KB, m)
+            scatter_rows(KB, rows, start, m, out)
+    else:
+        for i in range(n):
+            model_test_row(model_id, x[i], u[i], p, c[i], out[i])
 
 
 @row_kernel
 def rk4_stages(deriv, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
-    """Advance row ``i`` of ``x`` in place by one classic RK4 step of ``h`` [s] of the
-    derivative ``deriv`` (:func:`row_rhs` or :func:`row_rhs_all`).
+    """Advance row ``i`` of ``x`` in place by one classic RK4 step of ``h`` [s] of the per-ship
+    derivative ``deriv(model_id, x_i, u_i, p, c_i, out)`` (the model-test models, which run
+    one ship at a time).
 
     ``k1`` to ``k4`` and ``t`` are scratch vectors of length nx (the slopes and the stage state).
     """
@@ -122,8 +243,6 @@ def rk4_stages(deriv, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
     ci = c[i]
     for j in range(m):
         t[j] = xi[j]
-    # one call site for the four stages: the derivative is inlined once, not four times
-    # (compile time and code size grow with every inlined copy of every model)
     for s in range(4):
         k = k1 if s == 0 else k2 if s == 1 else k3 if s == 2 else k4
         deriv(model_id, t, ui, p, ci, k)
@@ -135,13 +254,6 @@ def rk4_stages(deriv, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
         xi[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 
 
-@row_kernel
-def rk4_row(model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
-    """:func:`rk4_stages` of an environment model (:func:`row_rhs`): the environments' and the
-    identification's kernels inline it without the models no environment uses."""
-    rk4_stages(row_rhs, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
-
-
 #: Batches at least this large are stepped by the parallel compilation of the env kernels.
 PARALLEL_MIN_ROWS = 64
 
@@ -150,10 +262,20 @@ PARALLEL_MIN_ROWS = 64
 def rk4_step_kernel(model_id, x, u, p, c, h):
     """Advance every row of ``x`` in place by one RK4 step of length ``h`` [s] (unchecked: see
     :func:`rk4_step`)."""
-    work = np.empty((5, x.shape[1]))
-    k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
-    for i in range(x.shape[0]):
-        rk4_stages(row_rhs_all, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
+    n = x.shape[0]
+    if model_id < KVLCC2:
+        rows = np.arange(n)
+        XB, UB, CB, W = block_work(x.shape[1], u.shape[1])
+        for start in range(0, n, BLOCK):
+            m = min(BLOCK, n - start)
+            gather_rows(x, u, c, rows, start, m, XB, UB, CB)
+            rk4_block(model_id, XB, UB, p, CB, h, m, W)
+            scatter_rows(XB, rows, start, m, x)
+    else:
+        work = np.empty((5, x.shape[1]))
+        k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
+        for i in range(n):
+            rk4_stages(model_test_row, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t)
 
 
 def check_parameters(model_id: int, p: np.ndarray) -> None:

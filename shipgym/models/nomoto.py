@@ -39,7 +39,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from shipgym.models._jit import row_kernel
+from shipgym.models._jit import simd_kernel
+from shipgym.models.vmath import sincos
 
 # Shared state and input indices of the Nomoto family.
 IX, IY, IPSI, IU, IR, IDELTA, IRDOT = 0, 1, 2, 3, 4, 5, 6
@@ -257,60 +258,87 @@ def pack_nomoto(
     return np.array(head + yaw.coefficients(), dtype=np.float64)
 
 
-@row_kernel
-def _actuators_and_kinematics(x, u, p, c, out):
-    """Steering gear, surge and position kinematics; returns ``delta'``."""
+@simd_kernel
+def _actuators_and_kinematics(X, U, p, C, b):
+    """Steering gear, surge and position kinematics of ship ``b`` of a block: returns
+    ``(x', y', psi', U', delta')``.
+
+    The model functions here take a block of ships column by column (``X`` states x ships,
+    ``U`` inputs x ships, ``C`` north/east current x ships, ``K`` the derivative), as
+    :func:`shipgym.models.integrate.rk4_block` steps them; one ship is a block of one.
+    Straight-line code (the sine and cosine of :mod:`shipgym.models.vmath`) that reads every
+    input before it writes, so a loop over the ships compiles to SIMD code.
+    """
     dmax = p[P_DMAX]
     rate = p[P_DRATE]
-    dc = min(max(u[0], -dmax), dmax)
-    ddot = min(max((dc - x[IDELTA]) / p[P_TDELTA], -rate), rate)
-    psi = x[IPSI]
-    speed = x[IU]
-    out[IX] = speed * math.cos(psi) + c[0]
-    out[IY] = speed * math.sin(psi) + c[1]
-    out[IPSI] = x[IR]
-    out[IU] = (p[P_KU] * u[1] - speed) / p[P_TU]
-    out[IDELTA] = ddot
-    return ddot
+    dc = min(max(U[0, b], -dmax), dmax)
+    ddot = min(max((dc - X[IDELTA, b]) / p[P_TDELTA], -rate), rate)
+    sn, cs = sincos(X[IPSI, b])
+    speed = X[IU, b]
+    return (
+        speed * cs + C[0, b],
+        speed * sn + C[1, b],
+        X[IR, b],
+        (p[P_KU] * U[1, b] - speed) / p[P_TU],
+        ddot,
+    )
 
 
-@row_kernel
-def nomoto1_row(x, u, p, c, out):
-    """First-order Nomoto derivative (seed 004 eq. 2)."""
-    _actuators_and_kinematics(x, u, p, c, out)
-    K, T = p[P_YAW], p[P_YAW + 1]
-    out[IR] = (K * x[IDELTA] - x[IR]) / T
+@simd_kernel
+def _store(K, b, xd, yd, psid, ud, ddot):
+    """Write the common derivatives of ship ``b`` (after every read of the model function)."""
+    K[IX, b] = xd
+    K[IY, b] = yd
+    K[IPSI, b] = psid
+    K[IU, b] = ud
+    K[IDELTA, b] = ddot
 
 
-@row_kernel
-def norrbin_row(x, u, p, c, out):
-    """Norrbin derivative (seed 002 eq. 1-3, seed 004 eq. 4)."""
-    _actuators_and_kinematics(x, u, p, c, out)
-    K, T = p[P_YAW], p[P_YAW + 1]
+@simd_kernel
+def nomoto1_col(X, U, p, C, K, b):
+    """First-order Nomoto derivative (seed 004 eq. 2) of ship ``b`` of a block."""
+    xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
+    gain, T = p[P_YAW], p[P_YAW + 1]
+    rd = (gain * X[IDELTA, b] - X[IR, b]) / T
+    _store(K, b, xd, yd, psid, ud, ddot)
+    K[IR, b] = rd
+
+
+@simd_kernel
+def norrbin_col(X, U, p, C, K, b):
+    """Norrbin derivative (seed 002 eq. 1-3, seed 004 eq. 4) of ship ``b`` of a block."""
+    xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
+    gain, T = p[P_YAW], p[P_YAW + 1]
     n0, n1, n2, n3 = p[P_YAW + 2], p[P_YAW + 3], p[P_YAW + 4], p[P_YAW + 5]
-    r = x[IR]
+    r = X[IR, b]
     hn = n3 * r * r * r + n2 * r * abs(r) + n1 * r + n0
-    out[IR] = (K * x[IDELTA] - hn) / T
+    rd = (gain * X[IDELTA, b] - hn) / T
+    _store(K, b, xd, yd, psid, ud, ddot)
+    K[IR, b] = rd
 
 
-@row_kernel
-def nomoto2_row(x, u, p, c, out):
-    """Second-order Nomoto derivative (seed 004 eq. 1)."""
-    ddot = _actuators_and_kinematics(x, u, p, c, out)
-    K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
-    rdot = x[IRDOT]
-    out[IR] = rdot
-    out[IRDOT] = (K * (x[IDELTA] + T3 * ddot) - (T1 + T2) * rdot - x[IR]) / (T1 * T2)
+@simd_kernel
+def nomoto2_col(X, U, p, C, K, b):
+    """Second-order Nomoto derivative (seed 004 eq. 1) of ship ``b`` of a block."""
+    xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
+    gain, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
+    rdot = X[IRDOT, b]
+    rdd = (gain * (X[IDELTA, b] + T3 * ddot) - (T1 + T2) * rdot - X[IR, b]) / (T1 * T2)
+    _store(K, b, xd, yd, psid, ud, ddot)
+    K[IR, b] = rdot
+    K[IRDOT, b] = rdd
 
 
-@row_kernel
-def bech_row(x, u, p, c, out):
-    """Bech derivative (seed 004 eq. 3)."""
-    ddot = _actuators_and_kinematics(x, u, p, c, out)
-    K, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
+@simd_kernel
+def bech_col(X, U, p, C, K, b):
+    """Bech derivative (seed 004 eq. 3) of ship ``b`` of a block."""
+    xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
+    gain, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
     b0, b1, b2, b3 = p[P_YAW + 4], p[P_YAW + 5], p[P_YAW + 6], p[P_YAW + 7]
-    r = x[IR]
-    rdot = x[IRDOT]
+    r = X[IR, b]
+    rdot = X[IRDOT, b]
     hb = b3 * r * r * r + b2 * r * abs(r) + b1 * r + b0
-    out[IR] = rdot
-    out[IRDOT] = (K * (x[IDELTA] + T3 * ddot) - (T1 + T2) * rdot - K * hb) / (T1 * T2)
+    rdd = (gain * (X[IDELTA, b] + T3 * ddot) - (T1 + T2) * rdot - gain * hb) / (T1 * T2)
+    _store(K, b, xd, yd, psid, ud, ddot)
+    K[IR, b] = rdot
+    K[IRDOT, b] = rdd

@@ -70,7 +70,7 @@ With zero thrust the relative-velocity dynamics are ``M nu_r' + (C_rb + C_a)(nu_
 D nu_r = 0`` for an irrotational current (Fossen 2011 property 8.1 holds for eq. 14), so with a
 symmetric ``M`` the kinetic energy relative to the water, ``nu_r^T M nu_r / 2``, never grows.
 
-The compiled per-ship functions here (:func:`rvg_row`, :func:`pod_thrust`, :func:`pod_thrusts`,
+The compiled per-ship functions here (:func:`rvg_col`, :func:`pod_thrust`, :func:`pod_thrusts`,
 :func:`pod_axial_inflow`) take their arrays unchecked: ``p`` must be :func:`pack_rvg`'s output
 and ``x`` a full state. From Python, :class:`shipgym.models.ShipModel` checks its arguments.
 """
@@ -82,8 +82,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from shipgym.models._jit import row_kernel
-from shipgym.models.kinematics import body_current, planar_kinematics
+from shipgym.models._jit import row_kernel, simd_kernel
+from shipgym.models.kinematics import body_current
+from shipgym.models.vmath import atan2, sincos
 
 RVG_PARAMETER_SETS = ("seed001", "sea_trials")
 """Names of the shipped parameter sets (:meth:`RVGParams.named`)."""
@@ -406,7 +407,7 @@ P_SIZE = P_CF_W + _GL_X.size
 
 
 def pack_rvg(params: RVGParams) -> np.ndarray:
-    """Parameter vector that :func:`rvg_row` reads."""
+    """Parameter vector that :func:`rvg_col` reads."""
     p = np.zeros(P_SIZE)
     M = params.mass_matrix
     Mrb = params.rigid_body_mass
@@ -480,79 +481,49 @@ def pod_thrusts(rpm, x, c, p):
     )
 
 
-@row_kernel
-def _pod_state_rates(x, u, p, out, ur):
-    """First-order pod thrust and azimuth dynamics with limits (eq. 18)."""
-    tmax = p[P_TBOLL] * min(max(1.0 - p[P_ADV] * ur * p[P_INV_U0], 0.0), 1.0)
-    amax = p[P_AMAX]
-    rate = p[P_ARATE]
-    for k in range(2):
-        tc = min(max(u[k], 0.0), tmax)
-        out[IT1 + k] = (tc - x[IT1 + k]) * p[P_INV_TAU_T]
-        ac = min(max(u[2 + k], -amax), amax)
-        out[IA1 + k] = min(max((ac - x[IA1 + k]) * p[P_INV_TAU_A], -rate), rate)
+@simd_kernel
+def rvg_col(X, U, p, C, K, b):
+    """RVG 3-DOF derivative (seed 001 eq. 5-20) of ship ``b`` of a block, written into ``K``.
 
-
-@row_kernel
-def rvg_row(x, u, p, c, out):
-    """RVG 3-DOF derivative (seed 001 eq. 5-20)."""
-    psi = x[IPSI]
-    cs = math.cos(psi)
-    sn = math.sin(psi)
-    uu = x[IU]
-    vv = x[IV]
-    r = x[IR]
-    planar_kinematics(uu, vv, r, cs, sn, out)  # eq. (6)
+    ``X`` (states x ships), ``U`` (inputs x ships), ``C`` (north/east current x ships) and
+    ``K`` hold a block of ships column by column (:func:`shipgym.models.integrate.rk4_block`);
+    one ship is a block of one. The function is straight-line arithmetic, its sines, cosines
+    and arctangents those of :mod:`shipgym.models.vmath`, so a loop over the ships of a block
+    compiles to SIMD code. The terms that are zero in seed 001 (pod lift, turning speed loss,
+    wave resistance) are computed whatever their coefficient; the cross-flow integral, the one
+    term with a loop of its own, is added by :func:`rvg_crossflow_col` after this function
+    when its coefficient is not zero (``block_rhs`` calls both), so that this loop stays
+    straight-line code.
+    """
+    sn, cs = sincos(X[IPSI, b])
+    uu = X[IU, b]
+    vv = X[IV, b]
+    r = X[IR, b]
     # eq. (8)-(10)
-    uc, vc = body_current(c, cs, sn)
+    cn = C[0, b]
+    ce = C[1, b]
+    uc = cn * cs + ce * sn
+    vc = -cn * sn + ce * cs
     ur = uu - uc
     vr = vv - vc
     # eq. (19)-(20), summed over both pods
-    ca1 = math.cos(x[IA1])
-    sa1 = math.sin(x[IA1])
-    if x[IA2] == x[IA1]:  # pods turned together (the usual case): no second sin/cos
-        ca2 = ca1
-        sa2 = sa1
-    else:
-        ca2 = math.cos(x[IA2])
-        sa2 = math.sin(x[IA2])
-    t1 = x[IT1] * p[P_HULL_T]  # thrust on the hull, (1 - t) T
-    t2 = x[IT2] * p[P_HULL_T]
+    sa1, ca1 = sincos(X[IA1, b])
+    sa2, ca2 = sincos(X[IA2, b])
+    th1 = X[IT1, b]
+    th2 = X[IT2, b]
+    x1, y1, x2, y2 = p[P_POD], p[P_POD + 1], p[P_POD + 2], p[P_POD + 3]
+    t1 = th1 * p[P_HULL_T]  # thrust on the hull, (1 - t) T
+    t2 = th2 * p[P_HULL_T]
     fx = t1 * ca1 + t2 * ca2
     fy = t1 * sa1 + t2 * sa2
-    fn = t1 * (-p[P_POD + 1] * ca1 + p[P_POD] * sa1) + t2 * (
-        -p[P_POD + 3] * ca2 + p[P_POD + 2] * sa2
-    )
+    fn = t1 * (-y1 * ca1 + x1 * sa1) + t2 * (-y2 * ca2 + x2 * sa2)
     # pod foil normal force from each pod's own inflow (module docstring; zero in seed 001)
-    if p[P_LIFT] != 0.0:
-        for k in range(2):
-            ca = ca1 if k == 0 else ca2
-            sa = sa1 if k == 0 else sa2
-            xt = p[P_POD + 2 * k]
-            yt = p[P_POD + 2 * k + 1]
-            up = ur - yt * r
-            vp = vr + xt * r
-            vv2 = up * up + vp * vp
-            q = vv2 + p[P_SLIP] * max(x[IT1 + k], 0.0)
-            if q > 0.0:
-                if vv2 > 0.0:
-                    vabs = math.sqrt(vv2)
-                    cb = up / vabs
-                    sb = vp / vabs
-                else:
-                    cb = 1.0
-                    sb = 0.0
-                # angle of attack alpha - beta_p, wrapped to [-pi, pi], then stalled
-                aoa = math.atan2(sa * cb - ca * sb, ca * cb + sa * sb)
-                stall = p[P_STALL]
-                if aoa > math.pi - stall:  # flow from astern: the foil works backwards
-                    aoa -= math.pi
-                elif aoa < stall - math.pi:
-                    aoa += math.pi
-                normal = p[P_LIFT] * q * math.sin(min(max(aoa, -stall), stall))
-                fx -= normal * sa
-                fy += normal * ca
-                fn += normal * (xt * ca + yt * sa)
+    lift, slip, stall = p[P_LIFT], p[P_SLIP], p[P_STALL]
+    n1 = lift * _pod_normal(ur - y1 * r, vr + x1 * r, sa1, ca1, th1, slip, stall)
+    n2 = lift * _pod_normal(ur - y2 * r, vr + x2 * r, sa2, ca2, th2, slip, stall)
+    fx -= n1 * sa1 + n2 * sa2
+    fy += n1 * ca1 + n2 * ca2
+    fn += n1 * (x1 * ca1 + y1 * sa1) + n2 * (x2 * ca2 + y2 * sa2)
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
     m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
     a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
@@ -571,19 +542,7 @@ def rvg_row(x, u, p, c, out):
     # wave-making resistance c_w Fn^2 rho/2 S |u_r| u_r (zero in seed 001)
     d0 += p[P_XW] * ur * ur * abs(ur) * ur
     # sway-yaw cross terms of the cross-flow drag integral (zero in seed 001)
-    if p[P_CF] != 0.0:
-        cf_y = 0.0
-        cf_n = 0.0
-        vq = abs(vr) * vr
-        for j in range(P_CF_W - P_CF_X):
-            xs = p[P_CF_X + j]
-            xr = xs * r
-            s = vr + xr
-            f = (abs(s) * s - vq - abs(xr) * xr) * p[P_CF_W + j]
-            cf_y += f
-            cf_n += f * xs
-        d1 += p[P_CF] * cf_y
-        d2 += p[P_CF] * cf_n
+    # the sway-yaw cross terms of the cross-flow drag: rvg_crossflow_col, when not zero
     # eq. (9): nu_c' = [r v_c, -r u_c, 0]; M_a nu_c'
     ncd0 = r * vc
     ncd1 = -r * uc
@@ -594,7 +553,84 @@ def rvg_row(x, u, p, c, out):
     b0 = fx - c_rb0 - c_a0 - d0 + ma0
     b1 = fy - c_rb1 - c_a1 - d1 + ma1
     b2 = fn - c_rb2 - c_a2 - d2 + ma2
-    out[IU] = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
-    out[IV] = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
-    out[IR] = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
-    _pod_state_rates(x, u, p, out, ur)
+    du = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
+    dv = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
+    dr = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
+    # first-order pod thrust and azimuth dynamics with limits (eq. 18)
+    tmax = p[P_TBOLL] * min(max(1.0 - p[P_ADV] * ur * p[P_INV_U0], 0.0), 1.0)
+    amax = p[P_AMAX]
+    rate = p[P_ARATE]
+    inv_tau_t = p[P_INV_TAU_T]
+    inv_tau_a = p[P_INV_TAU_A]
+    dt1 = (min(max(U[0, b], 0.0), tmax) - th1) * inv_tau_t
+    dt2 = (min(max(U[1, b], 0.0), tmax) - th2) * inv_tau_t
+    da1 = min(max((min(max(U[2, b], -amax), amax) - X[IA1, b]) * inv_tau_a, -rate), rate)
+    da2 = min(max((min(max(U[3, b], -amax), amax) - X[IA2, b]) * inv_tau_a, -rate), rate)
+    # every write after every read (the loop over the ships then compiles to SIMD code)
+    K[IX, b] = cs * uu - sn * vv  # eq. (6)
+    K[IY, b] = sn * uu + cs * vv
+    K[IPSI, b] = r
+    K[IU, b] = du
+    K[IV, b] = dv
+    K[IR, b] = dr
+    K[IT1, b] = dt1
+    K[IT2, b] = dt2
+    K[IA1, b] = da1
+    K[IA2, b] = da2
+
+
+@row_kernel
+def _pod_normal(up, vp, sa, ca, thrust, slip, stall):
+    """Foil normal force per unit lift coefficient of a pod at azimuth ``alpha`` (``sa``, ``ca``)
+    in the inflow ``(up, vp)`` [m/s] at the pod, with its slipstream at ``thrust`` (``slip`` the
+    slipstream factor ``k_s``, ``stall`` the stall angle [rad]).
+
+    ``q sin(clip(alpha - beta_p, +-stall))`` with ``q = |v_p|^2 + k_s max(T, 0)`` and the
+    inflow angle ``beta_p``; a flow from astern turns the foil's angle by pi (module
+    docstring). Zero without inflow. Straight-line code (selects), for SIMD.
+    """
+    vv2 = up * up + vp * vp
+    q = vv2 + slip * max(thrust, 0.0)
+    vabs = math.sqrt(vv2)
+    moving = vv2 > 0.0
+    cb = up / vabs if moving else 1.0
+    sb = vp / vabs if moving else 0.0
+    # angle of attack alpha - beta_p, wrapped to [-pi, pi], then stalled
+    aoa = atan2(sa * cb - ca * sb, ca * cb + sa * sb)
+    aoa = (
+        aoa - math.pi if aoa > math.pi - stall else aoa + math.pi if aoa < stall - math.pi else aoa
+    )
+    s_aoa = sincos(min(max(aoa, -stall), stall))[0]
+    return q * s_aoa if q > 0.0 else 0.0
+
+
+@simd_kernel
+def rvg_crossflow_col(X, p, C, K, b):
+    """Add the sway-yaw cross terms of the cross-flow drag integral (zero in seed 001) to the
+    derivative ``K`` of ship ``b`` that :func:`rvg_col` wrote.
+
+    ``Y_cf = c int (|v_r + x r| (v_r + x r) - |v_r| v_r - |x r| x r) dx``, ``N_cf`` the same
+    weighted by ``x``, over Gauss-Legendre stations along the hull; they enter the derivative
+    through ``M^-1`` as the other damping forces do (eq. 12, 15).
+    """
+    sn, cs = sincos(X[IPSI, b])
+    r = X[IR, b]
+    vr = X[IV, b] - (-C[0, b] * sn + C[1, b] * cs)
+    cf_y = 0.0
+    cf_n = 0.0
+    vq = abs(vr) * vr
+    for j in range(P_CF_W - P_CF_X):
+        xs = p[P_CF_X + j]
+        xr = xs * r
+        s = vr + xr
+        f = (abs(s) * s - vq - abs(xr) * xr) * p[P_CF_W + j]
+        cf_y += f
+        cf_n += f * xs
+    dy = p[P_CF] * cf_y
+    dn = p[P_CF] * cf_n
+    du = p[P_MINV + 1] * dy + p[P_MINV + 2] * dn
+    dv = p[P_MINV + 4] * dy + p[P_MINV + 5] * dn
+    dr = p[P_MINV + 7] * dy + p[P_MINV + 8] * dn
+    K[IU, b] -= du
+    K[IV, b] -= dv
+    K[IR, b] -= dr

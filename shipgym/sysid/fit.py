@@ -386,7 +386,7 @@ def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: n
         x[0, j] = x0[j]
     u = np.zeros((1, 2))
     c = np.zeros((1, 2))
-    work = np.empty((5, nx))
+    work = np.empty((3, nx))
     for j in range(nx):
         out[0, j] = x[0, j]
     for k in range(h.shape[0]):
@@ -394,7 +394,7 @@ def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: n
         x[0, IU] = speed[k]
         u[0, 0] = dc[k]
         u[0, 1] = n_cmd[k]
-        rk4_row(model_id, x, u, p, c, h[k], 0, work[0], work[1], work[2], work[3], work[4])
+        rk4_row(model_id, x, u, p, c, h[k], 0, work)
         for j in range(nx):
             out[k + 1, j] = x[0, j]
 

@@ -343,11 +343,11 @@ def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
         x[0, j] = x0[j]
     u = np.zeros((1, 2))
     c = np.zeros((1, 2))
-    work = np.empty((5, nx))
+    work = np.empty((3, nx))
     out[0] = x[0, IDELTA]
     for k in range(cmd.shape[0]):
         u[0, 0] = cmd[k]
-        rk4_row(NOMOTO1, x, u, p, c, h, 0, work[0], work[1], work[2], work[3], work[4])
+        rk4_row(NOMOTO1, x, u, p, c, h, 0, work)
         out[k + 1] = x[0, IDELTA]
 
 

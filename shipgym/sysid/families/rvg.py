@@ -379,7 +379,7 @@ def _windows_kernel(t, meas, rpm, az, starts, p, c, alpha0, v0, out):  # pragma:
     cc = np.empty((1, 2))
     cc[0, 0] = c[0]
     cc[0, 1] = c[1]
-    work = np.empty((5, 10))
+    work = np.empty((3, 10))
     amax = p[P_AMAX]
     for w in range(m):
         i0 = starts[w]
@@ -400,7 +400,7 @@ def _windows_kernel(t, meas, rpm, az, starts, p, c, alpha0, v0, out):  # pragma:
             u[0, 2] = az[k] + alpha0
             u[0, 3] = az[k] + alpha0
             h = t[k + 1] - t[k]
-            rk4_row(RVG3DOF, x, u, p, cc, h, 0, work[0], work[1], work[2], work[3], work[4])
+            rk4_row(RVG3DOF, x, u, p, cc, h, 0, work)
             for j in range(10):
                 out[k + 1, j] = x[0, j]
             out[k + 1, 4] += v0  # the recorded (offset) transverse speed
