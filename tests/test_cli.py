@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import numba
 import pytest
 
 from shipgym.cli import SUBCOMMANDS, main
@@ -65,16 +68,53 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
     assert main(argv) == 0
     captured = capsys.readouterr()
     report = json.loads(out.read_text())
+    counts = sorted({1, numba.config.NUMBA_NUM_THREADS})  # one thread and all of them
+    assert set(report["ratios"]["single"]) == set(CURRENT_ENV_IDS)
+    assert set(report["ratios"]["vector"]) == {
+        f"{e} threads={t}" for e in CURRENT_ENV_IDS for t in counts
+    }
     for kind in ("single", "vector"):
-        assert set(report["ratios"][kind]) == set(CURRENT_ENV_IDS)
         assert all(math.isfinite(v) and v > 0 for v in report["ratios"][kind].values())
     assert report["config"]["num_envs"] == 4
+    assert report["config"]["busy"] == 0
     assert _is_png(plot)
     # a table row per measurement with PASS/MISS where there is a target
     assert captured.out.count("| single env step time |") == len(CURRENT_ENV_IDS) + 1
     assert re.search(r"NomotoHeading-v0 .*\| (PASS|MISS) \|", captured.out)
     # progress: one line per measurement
-    assert len(re.findall(r"^\[\s*\d+/12\]", captured.err, flags=re.M)) == 12
+    n = 2 * (len(CURRENT_ENV_IDS) + 1) + len(CURRENT_ENV_IDS) * (len(counts) - 1)
+    assert len(re.findall(rf"^\[\s*\d+/{n}\]", captured.err, flags=re.M)) == n
+
+
+def test_busy_cores_load_the_machine_and_leave_nothing_running() -> None:
+    """The helpers of ``bench --busy`` really take CPU time, and are gone afterwards."""
+    from shipgym.bench import BusyCores
+
+    with BusyCores(1) as busy:
+        procs = list(busy._procs)
+        assert len(procs) == 1 and procs[0].is_alive()
+        pid = procs[0].pid
+        cpu0 = _cpu_seconds(pid)
+        time.sleep(0.5)
+        assert _cpu_seconds(pid) - cpu0 > 0.2  # spinning, not sleeping
+    assert not procs[0].is_alive()
+    with pytest.raises(ValueError, match=r"busy must be an integer in \[0, 64\]"):
+        BusyCores(-1)
+
+
+def _cpu_seconds(pid: int) -> float:
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def test_bench_busy_runs_both_paths_without_targets(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "busy.json"
+    argv = ["bench", "--steps", "20", "--num-envs", "4", "--repeats", "1", "--busy", "1"]
+    assert main([*argv, "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert report["config"]["busy"] == 1
+    assert all(r["passed"] is None for r in report["results"])  # targets are for idle cores
+    assert "1 busy helper processes" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(

@@ -14,6 +14,7 @@ import warnings
 from typing import Any
 
 import gymnasium as gym
+import numba
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
@@ -1005,3 +1006,28 @@ def test_vector_env_refuses_calls_out_of_order_as_the_single_env_does(env_id: st
         with pytest.raises(gym.error.ClosedEnvironmentError, match="closed"):
             call(vec)
     assert np.array_equal(vec.task.x, state)
+
+
+@pytest.mark.parametrize("env_id", ["shipgym/NomotoHeading-v0", "shipgym/RVGPathFollowing-v1"])
+def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
+    """``num_threads`` changes who steps the batch, never a number (across autoresets)."""
+    threads = numba.config.NUMBA_NUM_THREADS
+    runs = []
+    for count in (1, None):
+        venv = make_vec(env_id, 130, num_threads=count)
+        assert venv.num_threads == (threads if count is None else 1)
+        obs, _ = venv.reset(seed=9)
+        rng = np.random.default_rng(2)
+        trace = [obs]
+        for _ in range(40):
+            obs, rew, term, trunc, _ = venv.step(rng.uniform(-1, 1, venv.action_space.shape))
+            trace += [obs, rew, term, trunc]
+        runs.append(trace)
+        assert numba.get_num_threads() == threads  # the caller's setting is restored
+    assert all(np.array_equal(a, b) for a, b in zip(*runs, strict=True))
+
+
+@pytest.mark.parametrize("bad", [0, -1, 10**6, 1.5, "2", True])
+def test_vector_env_refuses_bad_num_threads(bad: Any) -> None:
+    with pytest.raises(ValueError, match=r"num_threads must be an integer in \[1, \d+\]"):
+        make_vec("shipgym/NomotoHeading-v0", 4, num_threads=bad)

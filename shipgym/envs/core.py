@@ -21,6 +21,7 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import gymnasium as gym
+import numba
 import numpy as np
 from gymnasium import spaces
 from gymnasium.utils import seeding
@@ -203,6 +204,15 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         finished episode's last observation and ``info`` are in ``info["final_obs"]`` and
         ``info["final_info"]`` (rows flagged by ``info["_final_obs"]`` and
         ``info["_final_info"]``), the form stable-baselines3 needs (:mod:`shipgym.rl.vec_env`).
+    num_threads : int or None
+        Threads that step the batch. 1 (the default) steps it on the calling thread, which is
+        the fastest choice whenever the cores are shared: with other busy processes (an RL
+        learner beside the env, a test suite, a sweep) a thread of a parallel step that the
+        operating system deschedules holds up the whole step, and the parallel step becomes
+        several times slower than the serial one (``shipgym bench --busy N`` measures it).
+        ``None`` uses every thread Numba has (``NUMBA_NUM_THREADS``, one per core), for
+        batches of at least 64 sub-envs on cores the env has to itself; results are bitwise
+        the same for every value.
     keep_options : bool
         What an autoreset does with the options of the last ``reset(options=...)``. False (the
         default, Gymnasium's ``SyncVectorEnv`` behaviour): an autoreset draws a fresh scenario
@@ -238,8 +248,21 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         render_mode: str | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         keep_options: bool = False,
+        num_threads: int | None = 1,
         **task_kwargs: Any,
     ) -> None:
+        max_threads = numba.config.NUMBA_NUM_THREADS
+        if num_threads is None:
+            num_threads = max_threads
+        if (
+            isinstance(num_threads, bool)
+            or not isinstance(num_threads, int | np.integer)
+            or not 1 <= num_threads <= max_threads
+        ):
+            raise ValueError(
+                f"num_threads must be an integer in [1, {max_threads}] (NUMBA_NUM_THREADS) or "
+                f"None for all of them, got {num_threads!r}"
+            )
         modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
         try:
             mode = AutoresetMode(autoreset_mode)
@@ -255,6 +278,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.keep_options = bool(keep_options)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.task = self.task_cls(num_envs, **task_kwargs)
+        self.task.num_threads = self.num_threads = int(num_threads)
         self.num_envs = int(num_envs)
         steps = self.task.max_episode_steps if max_episode_steps is None else max_episode_steps
         if not isinstance(steps, int | np.integer) or steps < 1:

@@ -39,6 +39,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
+import numba
 import numpy as np
 
 from shipgym.envs import kernels
@@ -258,9 +259,24 @@ class Task:
         raise NotImplementedError
 
     # --- shared ------------------------------------------------------------------------------
+    #: Threads of the task kernel (``ShipVectorEnv(num_threads=...)``); 1 runs it serially.
+    num_threads: int = 1
+
     def _kernel(self, n: int) -> Any:
         serial, parallel = kernels.KERNELS[self.kernel_name]
-        return parallel if n >= PARALLEL_MIN_ROWS else serial
+        if self.num_threads == 1 or n < PARALLEL_MIN_ROWS:
+            return serial
+        threads = self.num_threads
+
+        def run(*args: Any) -> Any:
+            before = numba.get_num_threads()  # a per-thread setting: restored after the call
+            numba.set_num_threads(threads)
+            try:
+                return parallel(*args)
+            finally:
+                numba.set_num_threads(before)
+
+        return run
 
     def _args(self, advance: bool, rows: np.ndarray) -> tuple[Any, ...]:
         m = self.model
