@@ -1031,3 +1031,25 @@ def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
 def test_vector_env_refuses_bad_num_threads(bad: Any) -> None:
     with pytest.raises(ValueError, match=r"num_threads must be an integer in \[1, \d+\]"):
         make_vec("shipgym/NomotoHeading-v0", 4, num_threads=bad)
+
+
+def test_row_streams_draw_what_gymnasium_generators_draw() -> None:
+    """The array-held PCG64 streams of the vector env are Gymnasium's ``np_random`` bit for
+    bit, whichever rows are drawn and in which order."""
+    from gymnasium.utils import seeding
+
+    from shipgym.envs.streams import RowStreams
+
+    seeds = [0, 1, 7, 2**40 + 3, 123_456_789]
+    streams = RowStreams(len(seeds), seeds)
+    generators = [seeding.np_random(s)[0] for s in seeds]
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        rows = rng.choice(len(seeds), size=rng.integers(1, 6), replace=False)
+        size = int(rng.integers(1, 9))
+        drawn = streams.random(rows, size)
+        for k, i in enumerate(rows):
+            assert np.array_equal(drawn[k], generators[i].random(size))
+    assert np.array_equal(streams.generator(3).random(4), generators[3].random(4))
+    with pytest.raises(ValueError, match="seed list must have 5 entries"):
+        streams.seed([1, 2])

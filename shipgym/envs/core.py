@@ -5,7 +5,9 @@
 (as Gymnasium's ``CartPoleVectorEnv``). Both step through the same task kernel, so the physics
 exists once. Sub-env ``i`` of a vector env reset with seed ``s`` draws from
 ``np_random(s + i)``, the generator of a single env reset with seed ``s + i`` (the convention of
-``SyncVectorEnv``), so the two produce identical trajectories under identical actions.
+``SyncVectorEnv``), so the two produce identical trajectories under identical actions; the
+vector env holds these streams as arrays (:class:`~shipgym.envs.streams.RowStreams`), so an
+autoreset of any number of sub-envs draws for all of them in one compiled pass.
 
 The vector env behaves as Gymnasium's ``SyncVectorEnv`` of single envs, ``info`` included
 (the same keys, ``_key`` flags, dtypes and values; :meth:`Task.batch_info` builds it for all
@@ -24,11 +26,11 @@ import gymnasium as gym
 import numba
 import numpy as np
 from gymnasium import spaces
-from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from shipgym.envs.kernels import REASONS
+from shipgym.envs.streams import RowStreams
 from shipgym.envs.tasks import Task
 
 
@@ -295,7 +297,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.single_observation_space, self.single_action_space = self._single_spaces()
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self._rngs = [seeding.np_random(None)[0] for _ in range(self.num_envs)]
+        #: the random stream of each sub-env (Gymnasium's ``np_random``, held as arrays)
+        self._streams = RowStreams(self.num_envs)
         self._prev_done = np.zeros(self.num_envs, dtype=np.bool_)
         #: Options of the autoresets: those of the last reset with ``keep_options``, else None.
         self._autoreset_options: dict[str, Any] | None = None
@@ -358,15 +361,15 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             )
             if len(seeds) != self.num_envs:
                 raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
-            self._rngs = [seeding.np_random(s)[0] for s in seeds]
-        self.task.reset_rows(range(self.num_envs), self._rngs, options)
+            self._streams = RowStreams(self.num_envs, seeds)  # a bad seed changes nothing
+        self.task.reset_rows(np.arange(self.num_envs), self._streams, options)
         self._autoreset_options = dict(options) if self.keep_options and options else None
         self._prev_done[:] = False
         self._needs_reset = False
         return self.task.obs.astype(np.float32), self._info()
 
     def _autoreset(self, rows: np.ndarray) -> None:
-        self.task.reset_rows(rows, [self._rngs[i] for i in rows], self._autoreset_options)
+        self.task.reset_rows(rows, self._streams, self._autoreset_options)
 
     def step(
         self, actions: Any

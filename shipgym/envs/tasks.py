@@ -43,6 +43,7 @@ import numba
 import numpy as np
 
 from shipgym.envs import kernels
+from shipgym.envs.streams import RowStreams
 from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
 from shipgym.models.angles import ssa
 from shipgym.models.integrate import PARALLEL_MIN_ROWS
@@ -311,10 +312,12 @@ class Task:
     def reset_rows(
         self,
         rows: Sequence[int] | np.ndarray,
-        rngs: Sequence[np.random.Generator],
+        rngs: Sequence[np.random.Generator] | RowStreams,
         options: Mapping[str, Any] | None = None,
     ) -> None:
-        """Reset ``rows``; row ``rows[k]`` draws from ``rngs[k]``; ``options`` override draws.
+        """Reset ``rows``; row ``rows[k]`` draws from ``rngs[k]``, or from its own stream of a
+        :class:`~shipgym.envs.streams.RowStreams` (all rows in one pass); ``options`` override
+        draws.
 
         Raises
         ------
@@ -331,9 +334,12 @@ class Task:
                 f"{sorted(COMMON_OPTIONS | self.task_options)}"
             )
         rows = np.asarray(rows, dtype=np.int64)
-        draws = np.empty((rows.size, self.n_draws))
-        for k, rng in enumerate(rngs):
-            draws[k] = rng.random(self.n_draws)
+        if isinstance(rngs, RowStreams):
+            draws = rngs.random(rows, self.n_draws)
+        else:
+            draws = np.empty((rows.size, self.n_draws))
+            for k, rng in enumerate(rngs):
+                draws[k] = rng.random(self.n_draws)
         speed = draws[:, 0] * self.max_current_speed
         direction = _uniform(draws[:, 1], -math.pi, math.pi)
         self._validate_task_options(options)  # every option, before anything is changed
