@@ -2,7 +2,10 @@
 
 * :class:`~shipgym.rl.vec_env.ShipgymVecEnv`: a stable-baselines3 ``VecEnv`` over the
   NumPy-batched vector env (imported on first use: it needs stable-baselines3);
-* :func:`~shipgym.rl.train.train`: PPO or SAC with normalisation and an evaluation callback;
+* :func:`~shipgym.rl.train.train`: PPO or SAC with normalisation and an evaluation callback,
+  checkpointed at every evaluation (:mod:`~shipgym.rl.checkpoints`);
+  :func:`~shipgym.rl.train.resume` continues an interrupted one;
+* :func:`~shipgym.rl.sweep.run_sweep`: hyperparameter sweeps as Ray Tune trials;
 * :func:`~shipgym.rl.agents.load_agent`: the shipped agents (or any trained folder) as
   evaluation policies.
 
@@ -14,7 +17,14 @@ from __future__ import annotations
 from typing import Any
 
 from shipgym.rl.agents import AGENT_DIR, AgentPolicy, load_agent, load_meta
-from shipgym.rl.train import ALGOS, BENCHMARK_SEED, VALIDATION_SEED, TrainResult, train
+from shipgym.rl.train import (
+    ALGOS,
+    BENCHMARK_SEED,
+    VALIDATION_SEED,
+    TrainResult,
+    resume,
+    train,
+)
 
 
 def __getattr__(name: str) -> Any:
@@ -35,5 +45,6 @@ __all__ = [
     "TrainResult",
     "load_agent",
     "load_meta",
+    "resume",
     "train",
 ]

@@ -8,6 +8,12 @@ progress bar. The result is an agent file (SB3 ``.zip``) and a JSON record of ho
 algorithm, hyperparameters, budget, seeds, wall time, learning curve, library versions, and the
 observation normaliser the policy needs (:func:`shipgym.rl.agents.load_agent` applies it).
 
+Nothing waits for the end: at every evaluation the best policy so far is written as the agent
+(its record marked ``"partial": true``) and the latest state as a checkpoint
+(:mod:`shipgym.rl.checkpoints`), which :func:`resume` continues with the same counter, curve
+and TensorBoard run. SB3's logs go to TensorBoard (``tensorboard/`` of the output folder by
+default), with the validation return as ``eval/mean_reward``.
+
 Seeds. Training sub-env ``i`` is seeded with ``seed + i``; the evaluation callback uses
 ``VALIDATION_SEED + i``; the benchmark evaluates from ``BENCHMARK_SEED`` on. The three ranges
 are disjoint for ``seed < VALIDATION_SEED - num_envs``, so no agent is scored on an episode it
