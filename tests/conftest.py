@@ -4,7 +4,7 @@
 into a fresh folder for the session. Whatever the code under test leaves there outside pytest's
 own ``tmp_path`` folders (an ``SB3-<date>`` logger folder, a temporary file not cleaned up) fails
 the run with the names of what was left; the folder is removed either way, so a test run leaves
-nothing in the system's temporary directory.
+nothing in the system's temporary directory. Torch runs on one thread (tiny networks).
 """
 
 from __future__ import annotations
@@ -27,6 +27,14 @@ def pytest_configure(config: pytest.Config) -> None:
     config.option.basetemp = str(_ROOT / _PYTEST_DIR)
     os.environ["TMPDIR"] = str(_ROOT)
     tempfile.tempdir = str(_ROOT)
+    # the tests' networks are tiny: torch's thread pool only adds synchronisation, and on
+    # shared cores (a loaded CI machine) it makes each layer several times slower
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    try:
+        import torch
+    except ImportError:  # pragma: no cover - the rl extra is part of the test install
+        return
+    torch.set_num_threads(1)
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
