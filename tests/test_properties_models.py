@@ -10,9 +10,9 @@ call either returns finite numbers or raises ``ValueError`` / ``TypeError`` with
 nothing crashes the interpreter, raises anything else or returns NaN silently (``ssa`` keeps a
 NaN angle NaN, a missing angle; nothing else may).
 
-The compiled per-ship kernels (``*_row``, ``rk4_stages``, ``rk4_row``, the kinematics helpers,
-``pod_thrust``) are building blocks for compiled code and take their arguments unchecked; they
-are not part of this contract.
+The compiled per-ship kernels (``*_col``, ``*_row``, ``rk4_block``, ``rk4_stages``, the
+kinematics helpers, ``pod_thrust``) are building blocks for compiled code and take their
+arguments unchecked; they are not part of this contract.
 """
 
 from __future__ import annotations

@@ -167,7 +167,7 @@ def _heading(
     n_sp = schedule.shape[1]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1])
+        work = block_work(x.shape[1], u.shape[1], n_rows)
         prev = np.empty(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
@@ -225,7 +225,7 @@ def _speed(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1])
+        work = block_work(x.shape[1], u.shape[1], n_rows)
         prev = np.empty(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
@@ -313,7 +313,7 @@ def _path(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1])
+        work = block_work(x.shape[1], u.shape[1], n_rows)
         prev = np.empty(obs.shape[1])
         s_before = np.empty(BLOCK)
         lo = chunk * CHUNK
@@ -408,7 +408,7 @@ def _target(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1])
+        work = block_work(x.shape[1], u.shape[1], n_rows)
         prev = np.empty(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)

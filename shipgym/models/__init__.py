@@ -6,8 +6,8 @@ The Python API (:func:`make_model`, the :class:`ShipModel` methods, ``integrate.
 ``integrate.rk4_step``, ``vmm.term_monomials``, :func:`current_ned`, :func:`ssa`) checks its
 arguments before any kernel sees them and raises ``TypeError`` or ``ValueError`` naming what was
 wrong and what was expected; it never returns NaN from finite input. The compiled per-ship
-kernels (``*_row``, ``rk4_stages``, ``rk4_row``, the kinematics helpers) are for compiled code
-and take their arguments unchecked.
+kernels (``*_col``, ``*_row``, ``rk4_block``, ``rk4_stages``, the kinematics helpers) are for
+compiled code and take their arguments unchecked.
 """
 
 from shipgym.models.angles import ssa

@@ -6,7 +6,7 @@
 ``rk4_step`` advances the batch in place by one classic fourth-order Runge-Kutta step with
 the input and current held over the step (seed 001 eq. 2). Every user of a model, the
 environments, the manoeuvres and identification, integrates through their compiled kernels
-(``rhs_kernel``, ``rk4_step_kernel``, ``rk4_block``, ``rk4_row``); ``rhs`` and ``rk4_step``
+(``rhs_kernel``, ``rk4_step_kernel``, ``rk4_block``); ``rhs`` and ``rk4_step``
 are the same kernels behind argument checks, for calls from Python.
 
 Block kernels
@@ -16,10 +16,11 @@ a time (:data:`BLOCK` ships, states x ships, :func:`rk4_block`): each model's de
 per-ship function of a column of the block (``nomoto1_col``, ..., ``rvg_col``), written as
 straight-line code with the sine, cosine and arctangent of :mod:`shipgym.models.vmath`, and the
 loop over the ships of a block compiles to SIMD instructions. The model is chosen once per
-block (:func:`block_rhs`), not once per ship and stage. One ship is a block of one
-(:func:`rk4_row`, the identification's replays), so every user of a model runs the same
-function and a ship's result does not depend on the batch it is in. The model-test models
-(MMG, VMM), which no environment uses, keep their per-ship functions and :func:`rk4_stages`.
+block (:func:`block_rhs`), not once per ship and stage. One ship is a block of one (the
+identification's replays hold their ship as a ``(nx, 1)`` block), so every user of a model
+runs the same function and a ship's result does not depend on the batch it is in. The
+model-test models (MMG, VMM), which no environment uses, keep their per-ship functions and
+:func:`rk4_stages`.
 
 Checked and unchecked entry points
 ----------------------------------
@@ -149,15 +150,11 @@ def rk4_block(model_id, X, U, p, C, h, n, W):
 
 
 @row_kernel
-def block_work(nx, nu):
-    """Work arrays of one block: states, inputs, current (ships as columns) and the RK4
-    scratch of :func:`rk4_block`."""
-    return (
-        np.empty((nx, BLOCK)),
-        np.empty((nu, BLOCK)),
-        np.empty((2, BLOCK)),
-        np.empty((3, nx, BLOCK)),
-    )
+def block_work(nx, nu, n):
+    """Work arrays of one block for a batch of ``n`` ships: states, inputs, current (ships as
+    columns) and the RK4 scratch of :func:`rk4_block`, ``min(n, BLOCK)`` ships wide."""
+    m = max(min(n, BLOCK), 1)
+    return (np.empty((nx, m)), np.empty((nu, m)), np.empty((2, m)), np.empty((3, nx, m)))
 
 
 @row_kernel
@@ -183,24 +180,6 @@ def scatter_rows(XB, rows, start, n, x):
 
 
 @row_kernel
-def rk4_row(model_id, x, u, p, c, h, i, work):
-    """:func:`rk4_block` of row ``i`` of ``x`` (an environment model): a block of one ship.
-    ``work`` is scratch of shape ``(3, nx)``. For the identification's replays, which step
-    one ship through a record."""
-    nx = x.shape[1]
-    rk4_block(
-        model_id,
-        x[i].reshape((nx, 1)),
-        u[i].reshape((u.shape[1], 1)),
-        p,
-        c[i].reshape((2, 1)),
-        h,
-        1,
-        work.reshape((3, nx, 1)),
-    )
-
-
-@row_kernel
 def model_test_row(model_id, x, u, p, c, out):
     """State derivative of one ship (1-D ``x``, ``u``, ``c``) of a model-test model: the MMG
     model or the general VMM."""
@@ -217,7 +196,7 @@ def rhs_kernel(model_id, x, u, p, c, out):
     n = x.shape[0]
     if model_id < KVLCC2:
         rows = np.arange(n)
-        XB, UB, CB, W = block_work(x.shape[1], u.shape[1])
+        XB, UB, CB, W = block_work(x.shape[1], u.shape[1], n)
         KB = W[0]
         for start in range(0, n, BLOCK):
             m = min(BLOCK, n - start)
@@ -265,7 +244,7 @@ def rk4_step_kernel(model_id, x, u, p, c, h):
     n = x.shape[0]
     if model_id < KVLCC2:
         rows = np.arange(n)
-        XB, UB, CB, W = block_work(x.shape[1], u.shape[1])
+        XB, UB, CB, W = block_work(x.shape[1], u.shape[1], n)
         for start in range(0, n, BLOCK):
             m = min(BLOCK, n - start)
             gather_rows(x, u, c, rows, start, m, XB, UB, CB)

@@ -50,7 +50,7 @@ input or response the gain and time constant are not identifiable and the optimi
 meaningless values (T of 1e9 s, K of 1e-40 1/s).
 
 **Rudder replay through the shared kernels.** The simulation runs
-:func:`shipgym.models.integrate.rk4_row` (the one model kernel and RK4 integrator) in a
+:func:`shipgym.models.integrate.rk4_block` (the one model kernel and RK4 integrator) in a
 loop over the record, compiled once per model so that the model dispatch folds away. At each
 sample the rudder state is set to the recorded ``delta[k]`` and the steering gear is given a
 time constant of ``1e6`` s, no angle or rate limit and the command
@@ -87,7 +87,7 @@ from shipgym.models import (
 )
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.base import MODEL_NAMES
-from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_row
+from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
 
 __all__ = [
@@ -381,26 +381,26 @@ class FitResult:
 @row_kernel
 def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
     nx = x0.shape[0]
-    x = np.empty((1, nx))
+    x = np.empty((nx, 1))  # a block of one ship (states x ships)
     for j in range(nx):
-        x[0, j] = x0[j]
-    u = np.zeros((1, 2))
-    c = np.zeros((1, 2))
-    work = np.empty((3, nx))
+        x[j, 0] = x0[j]
+    u = np.zeros((2, 1))
+    c = np.zeros((2, 1))
+    work = np.empty((3, nx, 1))
     for j in range(nx):
-        out[0, j] = x[0, j]
+        out[0, j] = x[j, 0]
     for k in range(h.shape[0]):
-        x[0, IDELTA] = delta[k]
-        x[0, IU] = speed[k]
+        x[IDELTA, 0] = delta[k]
+        x[IU, 0] = speed[k]
         u[0, 0] = dc[k]
-        u[0, 1] = n_cmd[k]
-        rk4_row(model_id, x, u, p, c, h[k], 0, work)
+        u[1, 0] = n_cmd[k]
+        rk4_block(model_id, x, u, p, c, h[k], 1, work)
         for j in range(nx):
-            out[k + 1, j] = x[0, j]
+            out[k + 1, j] = x[j, 0]
 
 
 # One compilation of the loop per model: with the model id a compile-time constant the model
-# dispatch of ``rk4_row`` folds away, which makes the replay about three times faster than
+# dispatch of ``rk4_block`` folds away, which makes the replay about three times faster than
 # with the id as a run-time argument (same arithmetic, identical results). Each is compiled
 # on first use.
 @kernel
@@ -446,7 +446,7 @@ def _replay_kernel(
 
     At step ``k`` the rudder and speed states are set to ``delta[k]``, ``speed[k]`` and the
     commands to ``dc[k]``, ``n_cmd[k]`` (see the module docstring), then one RK4 step of
-    ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_row`.
+    ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_block`.
     """
     _REPLAY_KERNELS[model_id](x0, delta, dc, speed, n_cmd, h, p, out)
 

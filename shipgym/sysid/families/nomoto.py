@@ -107,7 +107,7 @@ from scipy.signal import savgol_filter
 
 from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
 from shipgym.models._jit import kernel
-from shipgym.models.integrate import NOMOTO1, rk4_row
+from shipgym.models.integrate import NOMOTO1, rk4_block
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
@@ -334,21 +334,21 @@ class _Fitted:
 def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
     """:meth:`ShipModel.simulate` of a ``nomoto1`` model with inputs ``(cmd[k], 0)``, compiled.
 
-    The same RK4 steps (:func:`shipgym.models.integrate.rk4_row`, no current); writes the
+    The same RK4 steps (:func:`shipgym.models.integrate.rk4_block`, no current); writes the
     rudder state ``x[IDELTA]`` at every step into ``out`` (length ``cmd.size + 1``).
     """
     nx = x0.shape[0]
-    x = np.empty((1, nx))
+    x = np.empty((nx, 1))  # a block of one ship (states x ships)
     for j in range(nx):
-        x[0, j] = x0[j]
-    u = np.zeros((1, 2))
-    c = np.zeros((1, 2))
-    work = np.empty((3, nx))
-    out[0] = x[0, IDELTA]
+        x[j, 0] = x0[j]
+    u = np.zeros((2, 1))
+    c = np.zeros((2, 1))
+    work = np.empty((3, nx, 1))
+    out[0] = x[IDELTA, 0]
     for k in range(cmd.shape[0]):
         u[0, 0] = cmd[k]
-        rk4_row(NOMOTO1, x, u, p, c, h, 0, work)
-        out[k + 1] = x[0, IDELTA]
+        rk4_block(NOMOTO1, x, u, p, c, h, 1, work)
+        out[k + 1] = x[IDELTA, 0]
 
 
 def lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = None) -> np.ndarray:

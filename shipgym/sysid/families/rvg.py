@@ -14,7 +14,7 @@ into consecutive windows of ``window_s`` seconds (:data:`RVG_WINDOW_S`); each wi
 the measured hull state ``x, y, psi, u, v, r`` (``v = 0`` if not recorded; read off a local fit
 over :data:`START_SMOOTHING_S` around the start, not one noisy sample); the pods' thrust and
 azimuth are not measured, so they run on through the windows from the first orders, and each
-window is simulated by :func:`shipgym.models.integrate.rk4_row` with the record's sample steps
+window is simulated by :func:`shipgym.models.integrate.rk4_block` with the record's sample steps
 (:func:`replay_windows`, :func:`simulate_orders` for one free run).
 
 Calibration: the free parameters of the base
@@ -99,7 +99,7 @@ from scipy.signal import savgol_filter
 
 from shipgym.models import RVGParams
 from shipgym.models._jit import kernel
-from shipgym.models.integrate import RVG3DOF, rk4_row
+from shipgym.models.integrate import RVG3DOF, rk4_block
 from shipgym.models.rvg import (
     DRAUGHT,
     IA1,
@@ -374,35 +374,35 @@ def apply_values(base: RVGParams, values: Mapping[str, float]) -> RVGParams:
 def _windows_kernel(t, meas, rpm, az, starts, p, c, alpha0, v0, out):  # pragma: no cover - jit
     n = t.shape[0]
     m = starts.shape[0]
-    x = np.empty((1, 10))
-    u = np.empty((1, 4))
-    cc = np.empty((1, 2))
+    x = np.empty((10, 1))  # a block of one ship (states x ships)
+    u = np.empty((4, 1))
+    cc = np.empty((2, 1))
     cc[0, 0] = c[0]
-    cc[0, 1] = c[1]
-    work = np.empty((3, 10))
+    cc[1, 0] = c[1]
+    work = np.empty((3, 10, 1))
     amax = p[P_AMAX]
     for w in range(m):
         i0 = starts[w]
         i1 = starts[w + 1] if w + 1 < m else n
         for j in range(6):
-            x[0, j] = meas[i0, j]
-        x[0, 4] -= v0
+            x[j, 0] = meas[i0, j]
+        x[4, 0] -= v0
         if w == 0:  # pods at the first orders; later windows keep the simulated pod states
             a = min(max(az[i0] + alpha0, -amax), amax)
-            x[0, IA1] = a
-            x[0, IA2] = a
-            x[0, IT1], x[0, IT2] = pod_thrusts(rpm[i0], x[0], c, p)
+            x[IA1, 0] = a
+            x[IA2, 0] = a
+            x[IT1, 0], x[IT2, 0] = pod_thrusts(rpm[i0], x[:, 0], c, p)
         for j in range(10):
-            out[i0, j] = x[0, j]
+            out[i0, j] = x[j, 0]
         out[i0, 4] += v0
         for k in range(i0, i1 - 1):
-            u[0, 0], u[0, 1] = pod_thrusts(rpm[k], x[0], c, p)
-            u[0, 2] = az[k] + alpha0
-            u[0, 3] = az[k] + alpha0
+            u[0, 0], u[1, 0] = pod_thrusts(rpm[k], x[:, 0], c, p)
+            u[2, 0] = az[k] + alpha0
+            u[3, 0] = az[k] + alpha0
             h = t[k + 1] - t[k]
-            rk4_row(RVG3DOF, x, u, p, cc, h, 0, work)
+            rk4_block(RVG3DOF, x, u, p, cc, h, 1, work)
             for j in range(10):
-                out[k + 1, j] = x[0, j]
+                out[k + 1, j] = x[j, 0]
             out[k + 1, 4] += v0  # the recorded (offset) transverse speed
 
 
