@@ -90,11 +90,12 @@ def test_parse_address_forms() -> None:
 
 
 def test_batches_merge_to_the_run_over_all_seeds() -> None:
-    """Splitting is exact also for a neural policy (its lockstep calls have fixed blocks)."""
-    policy = make_policy("ppo", ENV)
-    whole = evaluate(ENV, policy, "ppo", 4, BENCHMARK_SEED, progress=_quiet)
+    """Batches of seeds merge into the evaluation of all of them (the neural policies' case,
+    whose lockstep calls have fixed blocks, is the Ray evaluate test below)."""
+    policy = make_policy("zero", ENV)
+    whole = evaluate(ENV, policy, "zero", 4, BENCHMARK_SEED, progress=_quiet)
     parts = [
-        evaluate(ENV, policy, "ppo", n, BENCHMARK_SEED + s, progress=_quiet)
+        evaluate(ENV, policy, "zero", n, BENCHMARK_SEED + s, progress=_quiet)
         for s, n in ((3, 1), (0, 1), (1, 2))
     ]
     merged = merge_results(parts)
@@ -104,9 +105,11 @@ def test_batches_merge_to_the_run_over_all_seeds() -> None:
         ValueError, match=f"from seed {BENCHMARK_SEED + 1}, got one from seed {BENCHMARK_SEED + 3}"
     ):
         merge_results([parts[0], parts[1]])
-    zero = evaluate(ENV, make_policy("zero", ENV), "zero", 1, BENCHMARK_SEED, progress=_quiet)
+    classic = evaluate(
+        ENV, make_policy("classic", ENV), "classic", 1, BENCHMARK_SEED, progress=_quiet
+    )
     with pytest.raises(ValueError, match="different evaluations"):
-        merge_results([zero, parts[2]])
+        merge_results([classic, parts[2]])
 
 
 def test_split_keeps_the_first_logs() -> None:
@@ -137,6 +140,7 @@ def local_ray():
 
 
 def test_evaluate_with_ray_equals_the_local_run(local_ray, tmp_path: Path, capsys) -> None:
+    """PPO: the local run calls the network on all four episodes, each task on two."""
     argv = ["evaluate", "--env", ENV, "--controller", "ppo", "--episodes", "4"]
     argv += ["--seed", str(BENCHMARK_SEED)]
     assert main([*argv, "--json", str(tmp_path / "local.json")]) == 0
