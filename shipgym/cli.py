@@ -1049,6 +1049,7 @@ def _build_train(sub: Any) -> None:
         nargs="?",
         const="local",
         default=None,
+        type=_ray_address,
         metavar="ADDRESS",
         help="run a sweep as Ray Tune trials: without ADDRESS on a Ray started on this machine, "
         "with HOST:PORT (as 'ray start --head' prints it) or 'auto' on that cluster (DIR must "
