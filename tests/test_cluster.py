@@ -192,11 +192,17 @@ def test_failing_task_is_reported_with_its_seed(local_ray, capsys) -> None:
 
 
 # ---- RLlib --------------------------------------------------------------------------------
-def test_rllib_remote_env_runner_makes_the_env_from_the_prefixed_id(local_ray) -> None:
+def test_rllib_remote_env_runner_makes_the_env_from_the_prefixed_id(
+    local_ray, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """RLlib's env runners are fresh processes that never import shipgym: the id with its module
     prefix (``shipgym:``) imports it there; one PPO iteration on one remote runner."""
     pytest.importorskip("ray.rllib", reason="RLlib is not installed (pip install 'shipgym[rllib]')")
     from ray.rllib.algorithms.ppo import PPOConfig
+    from ray.tune.trainable import trainable
+
+    # an algorithm outside Tune logs into ~/ray_results: keep the test's folder there instead
+    monkeypatch.setattr(trainable, "DEFAULT_STORAGE_PATH", str(tmp_path))
 
     config = (
         PPOConfig()
