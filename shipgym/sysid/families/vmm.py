@@ -47,10 +47,10 @@ from scipy.linalg import qr
 from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
-from shipgym.models._jit import kernel, row_kernel
+from shipgym.models._jit import kernel
 from shipgym.models.base import make_model
-from shipgym.models.integrate import KVLCC2, VMM, rk4_stages
-from shipgym.models.mmg import KVLCC2_SCALE, MMGParams, mmg_row, pack_mmg
+from shipgym.models.integrate import KVLCC2, VMM, model_test_row, rk4_stages
+from shipgym.models.mmg import KVLCC2_SCALE, MMGParams, pack_mmg
 from shipgym.models.vmm import (
     P_INV,
     P_MU,
@@ -60,7 +60,6 @@ from shipgym.models.vmm import (
     pack_vmm,
     propeller_loading,
     term_monomials,
-    vmm_row,
 )
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
@@ -500,16 +499,6 @@ def regress(
 # replay (simulation of runs from the measured states)
 
 
-@row_kernel
-def _model_test_deriv(model_id, x, u, p, c, out):  # pragma: no cover - jit
-    """The derivative of the two model-test models (compiles neither the Nomoto nor the RVG
-    model into the replay)."""
-    if model_id == KVLCC2:
-        mmg_row(x, u, p, c, out)
-    else:
-        vmm_row(x, u, p, c, out)
-
-
 @kernel
 def _replay_kernel(model_id, t, starts, ends, x0, inputs, p, c, out):  # pragma: no cover - jit
     """Simulate windows ``[starts[w], ends[w])`` of concatenated samples, each from
@@ -548,7 +537,7 @@ def _replay_kernel(model_id, t, starts, ends, x0, inputs, p, c, out):  # pragma:
                 u[0, 1] = 0.5 * (inputs[k, 4] + inputs[k + 1, 4])
             x[0, 6] = u[0, 0]
             h = t[k + 1] - t[k]
-            rk4_stages(_model_test_deriv, model_id, x, u, p, cc, h, 0, work[0], work[1],
+            rk4_stages(model_test_row, model_id, x, u, p, cc, h, 0, work[0], work[1],
                        work[2], work[3], work[4])  # fmt: skip
             for j in range(6):
                 out[k + 1, j] = x[0, j]
