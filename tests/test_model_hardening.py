@@ -170,6 +170,9 @@ def test_current_and_angle_helpers_refuse_bad_arrays() -> None:
         propeller_loading(np.ones(2), -1.0, 1000.0)
     with pytest.raises(ValueError, match=r"too large\) must be finite"):
         propeller_loading(np.ones(2), 1e300, 1025.0)  # D^4 overflows: ValueError, no OverflowError
+    # zero revolutions give zero thrust however large D^4 is (never inf * 0 = NaN)
+    with np.errstate(all="raise"):
+        np.testing.assert_array_equal(propeller_loading(np.zeros(3), 2e76, 1025.0), np.zeros(3))
 
 
 # --------------------------------------------------------------------------------------------

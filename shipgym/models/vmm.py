@@ -185,8 +185,9 @@ def propeller_loading(rps: np.ndarray, diameter: float, rho: float) -> np.ndarra
     require_finite(n, "rps")
     diameter = positive_number(diameter, "diameter")
     rho = positive_number(rho, "rho")
-    with np.errstate(over="ignore"):
-        loading = rho * np.float64(diameter) ** 4 * n * np.abs(n)  # inf, never OverflowError
+    with np.errstate(over="ignore", invalid="ignore"):  # inf, never OverflowError
+        # no revolutions give no thrust however large D^4 is (never inf * 0 = NaN)
+        loading = np.where(n == 0.0, 0.0, rho * np.float64(diameter) ** 4 * (n * np.abs(n)))
     require_finite(loading, "propeller loading rho D^4 n |n| (too large)")
     return loading
 
