@@ -52,28 +52,23 @@ def first_nonfinite_row(a):
 
 
 @row_kernel
-def _map_action(a, u0, B, u, i):
-    """Clip row ``i`` of the actions to [-1, 1] and map it to inputs, ``u = u0 + B a``."""
-    na = a.shape[1]
-    for k in range(na):
-        a[i, k] = min(max(a[i, k], -1.0), 1.0)
-    for j in range(u0.shape[0]):
-        acc = u0[j]
-        for k in range(na):
-            acc += B[j, k] * a[i, k]
-        u[i, j] = acc
-
-
-@row_kernel
 def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
-    """Map the actions of rows ``rows[start .. start + n - 1]`` to inputs, count their step
-    and take one RK4 step of the block (:func:`~shipgym.models.integrate.rk4_block`).
+    """Clip the actions of rows ``rows[start .. start + n - 1]`` to [-1, 1], map them to inputs
+    (``u = u0 + B a``), count their step and take one RK4 step of the block
+    (:func:`~shipgym.models.integrate.rk4_block`).
 
     ``work`` is one block's work arrays (:func:`~shipgym.models.integrate.block_work`).
     """
+    na = a.shape[1]
     for j in range(start, start + n):
         i = rows[j]
-        _map_action(a, u0, B, u, i)
+        for k in range(na):
+            a[i, k] = min(max(a[i, k], -1.0), 1.0)
+        for q in range(u0.shape[0]):
+            acc = u0[q]
+            for k in range(na):
+                acc += B[q, k] * a[i, k]
+            u[i, q] = acc
         steps[i] += 1
     XB, UB, CB, W = work
     gather_rows(x, u, c, rows, start, n, XB, UB, CB)
@@ -81,54 +76,71 @@ def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, wo
     scatter_rows(XB, rows, start, n, x)
 
 
+# The row logic of the task kernels works a block of rows at a time: a helper that takes arrays
+# costs reference counting at every call, once per block here rather than once per row.
+
+
 @row_kernel
-def _begin_row(x, i, rew, term, reason):
-    """Clear the flags of row ``i``; False (and terminate with a blow-up) if it is not finite."""
-    reason[i] = RUNNING
-    term[i] = False
-    for j in range(x.shape[1]):
-        if not math.isfinite(x[i, j]):
+def _begin_block(x, rows, start, n, ok, rew, term, reason):
+    """Clear the flags of rows ``rows[start .. start + n - 1]``; ``ok[b]`` False (and the row
+    terminated with a blow-up) where the state of the ``b``-th is not finite."""
+    for b in range(n):
+        i = rows[start + b]
+        reason[i] = RUNNING
+        term[i] = False
+        finite = True
+        for j in range(x.shape[1]):
+            finite &= math.isfinite(x[i, j])
+        ok[b] = finite
+        if not finite:
             rew[i] = 0.0
             term[i] = True
             reason[i] = BLOW_UP
-            return False
-    return True
 
 
 @row_kernel
-def _keep_obs(obs, i, prev):
-    """Copy row ``i`` of the observations into ``prev`` before it is recomputed."""
-    for k in range(obs.shape[1]):
-        prev[k] = obs[i, k]
+def _keep_block(obs, rows, start, n, a, prev, cost):
+    """Copy the observations of the block's rows into ``prev`` before they are recomputed, and
+    put the squared norm of each row's action into ``cost``."""
+    for b in range(n):
+        i = rows[start + b]
+        for k in range(obs.shape[1]):
+            prev[b, k] = obs[i, k]
+        s = 0.0
+        for k in range(a.shape[1]):
+            s += a[i, k] * a[i, k]
+        cost[b] = s
 
 
 @row_kernel
-def _finish_row(obs, i, lo, hi, prev, rew, term, reason):
-    """Clip row ``i`` of the observations to the observation space bounds.
+def _finish_block(obs, rows, start, n, ok, lo, hi, prev, rew, term, reason):
+    """Clip the observations of the block's rows (those with ``ok``) to the observation-space
+    bounds.
 
     A NaN in the observation or the reward (a finite state whose observation overflowed) ends
     the row as a blow-up: the observation ``prev`` it had before, reward 0.
     """
-    bad = math.isnan(rew[i])
-    for k in range(obs.shape[1]):
-        if math.isnan(obs[i, k]):
-            bad = True
-    if bad:
+    for b in range(n):
+        if not ok[b]:
+            continue
+        i = rows[start + b]
+        bad = math.isnan(rew[i])
         for k in range(obs.shape[1]):
-            obs[i, k] = prev[k]
-        rew[i] = 0.0
-        term[i] = True
-        reason[i] = BLOW_UP
-    for k in range(obs.shape[1]):
-        obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
+            bad |= math.isnan(obs[i, k])
+        if bad:
+            for k in range(obs.shape[1]):
+                obs[i, k] = prev[b, k]
+            rew[i] = 0.0
+            term[i] = True
+            reason[i] = BLOW_UP
+        for k in range(obs.shape[1]):
+            obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
 
 
 @row_kernel
-def _action_cost(a, i):
-    s = 0.0
-    for k in range(a.shape[1]):
-        s += a[i, k] * a[i, k]
-    return s
+def _row_work(obs_dim):
+    """Per-chunk scratch of the row logic: ``ok``, ``prev`` and ``cost`` of one block."""
+    return np.empty(BLOCK, dtype=np.bool_), np.empty((BLOCK, obs_dim)), np.empty(BLOCK)
 
 
 def _heading(
@@ -168,24 +180,25 @@ def _heading(
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         work = block_work(x.shape[1], u.shape[1], n_rows)
-        prev = np.empty(obs.shape[1])
+        ok, prev, cost = _row_work(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
         for start in range(lo, hi, BLOCK):
             m = min(BLOCK, hi - start)
             if advance:
                 _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            for j in range(start, start + m):
-                i = rows[j]
-                if _begin_row(x, i, rew, term, reason):
-                    _keep_obs(obs, i, prev)
+            _begin_block(x, rows, start, m, ok, rew, term, reason)
+            _keep_block(obs, rows, start, m, a, prev, cost)
+            for b in range(m):
+                if ok[b]:
+                    i = rows[start + b]
                     psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
                     e = ssa_scalar(psi_d - x[i, ipsi])
                     obs[i, 0] = e
                     for k in range(obs_idx.shape[0]):
                         obs[i, 1 + k] = x[i, obs_idx[k]]
-                    rew[i] = -abs(e) / math.pi - 0.05 * _action_cost(a, i)
-                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                    rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -226,17 +239,18 @@ def _speed(
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         work = block_work(x.shape[1], u.shape[1], n_rows)
-        prev = np.empty(obs.shape[1])
+        ok, prev, cost = _row_work(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
         for start in range(lo, hi, BLOCK):
             m = min(BLOCK, hi - start)
             if advance:
                 _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            for j in range(start, start + m):
-                i = rows[j]
-                if _begin_row(x, i, rew, term, reason):
-                    _keep_obs(obs, i, prev)
+            _begin_block(x, rows, start, m, ok, rew, term, reason)
+            _keep_block(obs, rows, start, m, a, prev, cost)
+            for b in range(m):
+                if ok[b]:
+                    i = rows[start + b]
                     psi = x[i, 2]
                     ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
                     ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
@@ -248,24 +262,21 @@ def _speed(
                     e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
                     f = min(max(frac, obs_lo[2]), obs_hi[2])
                     rew[i] = -abs(e) / 2.0 - 0.05 * f * f
-                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
 @row_kernel
-def path_geometry(px, py, tangent, leg_length, seg, i):
-    """Cross-track error and along-track distance left on the active leg ``seg[i]``.
+def path_geometry(px, py, xk, yk, cs, sn, length):
+    """Cross-track error and along-track distance left on a leg from ``(x_k, y_k)`` of course
+    ``chi_p`` (``cs, sn = cos chi_p, sin chi_p``) and ``length`` [m].
 
     ``e = -(x - x_k) sin(chi_p) + (y - y_k) cos(chi_p)`` is positive when the ship is to the
-    right (starboard side) of the path (Fossen 2011, eq. 10.55). ``tangent[i, k]`` holds
-    ``(x_k, y_k, cos chi_p, sin chi_p)`` of leg ``k``.
+    right (starboard side) of the path (Fossen 2011, eq. 10.55).
     """
-    k = seg[i]
-    dn = px - tangent[i, k, 0]
-    de = py - tangent[i, k, 1]
-    cs = tangent[i, k, 2]
-    sn = tangent[i, k, 3]
-    return -dn * sn + de * cs, leg_length[i, k] - (dn * cs + de * sn)
+    dn = px - xk
+    de = py - yk
+    return -dn * sn + de * cs, length - (dn * cs + de * sn)
 
 
 def _path(
@@ -314,59 +325,71 @@ def _path(
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         work = block_work(x.shape[1], u.shape[1], n_rows)
-        prev = np.empty(obs.shape[1])
+        ok, prev, cost = _row_work(obs.shape[1])
         s_before = np.empty(BLOCK)
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
         for start in range(lo, hi, BLOCK):
             m = min(BLOCK, hi - start)
-            for j in range(start, start + m):  # along-track distance left before the step
-                i = rows[j]
-                s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)[1]
-                s_before[j - start] = s_left
+            for b in range(m):  # along-track distance left before the step
+                i = rows[start + b]
+                k = seg[i]
+                t = tangent[i, k]
+                s_before[b] = path_geometry(
+                    x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
+                )[1]
             if advance:
                 _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            for j in range(start, start + m):
-                i = rows[j]
-                if _begin_row(x, i, rew, term, reason):
-                    _keep_obs(obs, i, prev)
-                    e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                    progress = s_before[j - start] - s_left
-                    k = seg[i]
-                    dist_end = math.hypot(
-                        x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
-                    )
-                    bonus = 0.0
-                    if dist_end < accept_radius or s_left < 0.0:
-                        if k + 2 < n_wp[i]:
-                            seg[i] = k + 1
-                            e, s_left = path_geometry(x[i, 0], x[i, 1], tangent, leg_length, seg, i)
-                        else:
-                            term[i] = True
-                            reason[i] = SUCCESS
-                            bonus = 20.0
-                    if abs(e) > max_cross_track:
+            _begin_block(x, rows, start, m, ok, rew, term, reason)
+            _keep_block(obs, rows, start, m, a, prev, cost)
+            for b in range(m):
+                if not ok[b]:
+                    continue
+                i = rows[start + b]
+                k = seg[i]
+                t = tangent[i, k]
+                e, s_left = path_geometry(
+                    x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
+                )
+                progress = s_before[b] - s_left
+                dist_end = math.hypot(
+                    x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
+                )
+                bonus = 0.0
+                if dist_end < accept_radius or s_left < 0.0:
+                    if k + 2 < n_wp[i]:
+                        k += 1
+                        seg[i] = k
+                        t = tangent[i, k]
+                        e, s_left = path_geometry(
+                            x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
+                        )
+                    else:
                         term[i] = True
-                        reason[i] = FAILURE
-                        bonus = -20.0
-                    chi_err = ssa_scalar(leg_angle[i, seg[i]] - x[i, 2])
-                    obs[i, 0] = e
-                    obs[i, 1] = chi_err
-                    obs[i, 2] = s_left
-                    obs[i, 3] = turn[i, seg[i]]
-                    obs[i, 4] = x[i, 3]
-                    obs[i, 5] = x[i, 4]
-                    obs[i, 6] = x[i, 5]
-                    obs[i, 7] = x[i, 8]
-                    obs[i, 8] = x[i, 6] / tb
-                    rew[i] = (
-                        0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
-                        + 0.5 * math.exp(-((e / 25.0) ** 2))
-                        - 0.1 * abs(chi_err) / math.pi
-                        - 0.05 * _action_cost(a, i)
-                        + bonus
-                    )
-                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+                        reason[i] = SUCCESS
+                        bonus = 20.0
+                if abs(e) > max_cross_track:
+                    term[i] = True
+                    reason[i] = FAILURE
+                    bonus = -20.0
+                chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
+                obs[i, 0] = e
+                obs[i, 1] = chi_err
+                obs[i, 2] = s_left
+                obs[i, 3] = turn[i, k]
+                obs[i, 4] = x[i, 3]
+                obs[i, 5] = x[i, 4]
+                obs[i, 6] = x[i, 5]
+                obs[i, 7] = x[i, 8]
+                obs[i, 8] = x[i, 6] / tb
+                rew[i] = (
+                    0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
+                    + 0.5 * math.exp(-((e / 25.0) ** 2))
+                    - 0.1 * abs(chi_err) / math.pi
+                    - 0.05 * cost[b]
+                    + bonus
+                )
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -409,47 +432,50 @@ def _target(
     n_rows = rows.shape[0]
     for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
         work = block_work(x.shape[1], u.shape[1], n_rows)
-        prev = np.empty(obs.shape[1])
+        ok, prev, cost = _row_work(obs.shape[1])
         lo = chunk * CHUNK
         hi = min(n_rows, lo + CHUNK)
         for start in range(lo, hi, BLOCK):
             m = min(BLOCK, hi - start)
             if advance:
                 _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            for j in range(start, start + m):
-                i = rows[j]
-                if advance:
+                for b in range(m):
+                    i = rows[start + b]
                     target[i, 0] += target_vel[i, 0] * dt
                     target[i, 1] += target_vel[i, 1] * dt
-                if _begin_row(x, i, rew, term, reason):
-                    _keep_obs(obs, i, prev)
-                    psi = x[i, 2]
-                    cs = math.cos(psi)
-                    sn = math.sin(psi)
-                    dn = target[i, 0] - x[i, 0]
-                    de = target[i, 1] - x[i, 1]
-                    vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
-                    ve = sn * x[i, 3] + cs * x[i, 4]
-                    rvn = target_vel[i, 0] - vn
-                    rve = target_vel[i, 1] - ve
-                    d = math.hypot(dn, de)
-                    err = d - distance[i]
-                    obs[i, 0] = cs * dn + sn * de
-                    obs[i, 1] = -sn * dn + cs * de
-                    obs[i, 2] = cs * rvn + sn * rve
-                    obs[i, 3] = -sn * rvn + cs * rve
-                    obs[i, 4] = err
-                    obs[i, 5] = x[i, 3]
-                    obs[i, 6] = x[i, 4]
-                    obs[i, 7] = x[i, 5]
-                    obs[i, 8] = x[i, 8]
-                    obs[i, 9] = x[i, 6] / tb
-                    rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * _action_cost(a, i)
-                    if d > max_distance:
-                        term[i] = True
-                        reason[i] = FAILURE
-                        rew[i] -= 20.0
-                    _finish_row(obs, i, obs_lo, obs_hi, prev, rew, term, reason)
+            _begin_block(x, rows, start, m, ok, rew, term, reason)
+            _keep_block(obs, rows, start, m, a, prev, cost)
+            for b in range(m):
+                if not ok[b]:
+                    continue
+                i = rows[start + b]
+                psi = x[i, 2]
+                cs = math.cos(psi)
+                sn = math.sin(psi)
+                dn = target[i, 0] - x[i, 0]
+                de = target[i, 1] - x[i, 1]
+                vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
+                ve = sn * x[i, 3] + cs * x[i, 4]
+                rvn = target_vel[i, 0] - vn
+                rve = target_vel[i, 1] - ve
+                d = math.hypot(dn, de)
+                err = d - distance[i]
+                obs[i, 0] = cs * dn + sn * de
+                obs[i, 1] = -sn * dn + cs * de
+                obs[i, 2] = cs * rvn + sn * rve
+                obs[i, 3] = -sn * rvn + cs * rve
+                obs[i, 4] = err
+                obs[i, 5] = x[i, 3]
+                obs[i, 6] = x[i, 4]
+                obs[i, 7] = x[i, 5]
+                obs[i, 8] = x[i, 8]
+                obs[i, 9] = x[i, 6] / tb
+                rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * cost[b]
+                if d > max_distance:
+                    term[i] = True
+                    reason[i] = FAILURE
+                    rew[i] -= 20.0
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
