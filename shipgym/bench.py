@@ -13,8 +13,8 @@ All numbers come from one process, so they share the machine state and are compa
   actions (autoreset inside the env). Ratio ``env_sps / cartpole_sps`` from the best repeats
   (higher is better).
 
-Each vector env is measured on one thread (``num_threads=1``, the default) and on all of
-Numba's threads (``num_threads=None``); ``busy=N`` (``shipgym bench --busy N``) runs the whole
+Each vector env is measured on one thread (``num_threads=1``, the default) and on one thread
+per CPU (``num_threads=None``); ``busy=N`` (``shipgym bench --busy N``) runs the whole
 benchmark while ``N`` helper processes keep cores busy, as an RL learner, a test suite or a
 sweep does, so that both paths are compared on shared cores too. CartPole is measured under
 the same load, so the ratios compare like with like.
@@ -38,11 +38,11 @@ from pathlib import Path
 from typing import Any, TextIO
 
 import gymnasium as gym
-import numba
 import numpy as np
 
 import shipgym
 from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS
+from shipgym.envs.kernels import available_threads
 
 CARTPOLE_ID = "CartPole-v1"
 CARTPOLE_VECTOR = "CartPoleVectorEnv"
@@ -102,7 +102,7 @@ class Measurement:
 def _check_target(
     kind: str, env_id: str, threads: int, ratio: float
 ) -> tuple[str | None, bool | None]:
-    all_threads = threads == numba.config.NUMBA_NUM_THREADS and threads > 1
+    all_threads = threads == available_threads() and threads > 1
     target = TARGETS.get((kind, env_id, 0 if all_threads else threads))
     if target is None:
         return None, None
@@ -258,8 +258,8 @@ def run_bench(
         Where a line per measurement is printed as it completes: a file, ``True`` for
         ``sys.stderr`` (the default) or ``False`` for silence.
     threads : tuple of int or None
-        ``num_threads`` values each vector env is measured with (``None``: all of Numba's
-        threads; a value equal to an earlier one is measured once).
+        ``num_threads`` values each vector env is measured with (``None``: one thread per
+        CPU; a value equal to an earlier one is measured once).
     busy : int
         Helper processes that keep cores busy during the whole benchmark (:class:`BusyCores`).
 
@@ -278,7 +278,7 @@ def run_bench(
     unknown = [e for e in env_ids if e not in ENV_IDS]
     if unknown:
         raise ValueError(f"unknown env id(s) {unknown}; expected any of {list(ENV_IDS)}")
-    max_threads = numba.config.NUMBA_NUM_THREADS
+    max_threads = available_threads()
     thread_counts: list[int] = []
     for t in threads:
         count = max_threads if t is None else t

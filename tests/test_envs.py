@@ -14,7 +14,6 @@ import warnings
 from typing import Any
 
 import gymnasium as gym
-import numba
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
@@ -1010,12 +1009,19 @@ def test_vector_env_refuses_calls_out_of_order_as_the_single_env_does(env_id: st
 
 @pytest.mark.parametrize("env_id", ["shipgym/NomotoHeading-v0", "shipgym/RVGPathFollowing-v1"])
 def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
-    """``num_threads`` changes who steps the batch, never a number (across autoresets)."""
-    threads = numba.config.NUMBA_NUM_THREADS
+    """``num_threads`` changes who steps the batch, never a number (across autoresets); the
+    batch split into more parts than there are CPUs gives the same numbers too."""
+    from shipgym.envs import kernels
+
+    threads = kernels.available_threads()
     runs = []
-    for count in (1, None):
-        venv = make_vec(env_id, 130, num_threads=count)
+    for count in (1, None, 3):
+        venv = make_vec(
+            env_id, 130, num_threads=1 if count == 3 else count, max_episode_steps=15
+        )
         assert venv.num_threads == (threads if count is None else 1)
+        if count == 3:  # three parts of 44, 43 and 43 rows, whatever the machine has
+            venv.task.num_threads = 3
         obs, _ = venv.reset(seed=9)
         rng = np.random.default_rng(2)
         trace = [obs]
@@ -1023,8 +1029,22 @@ def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
             obs, rew, term, trunc, _ = venv.step(rng.uniform(-1, 1, venv.action_space.shape))
             trace += [obs, rew, term, trunc]
         runs.append(trace)
-        assert numba.get_num_threads() == threads  # the caller's setting is restored
-    assert all(np.array_equal(a, b) for a, b in zip(*runs, strict=True))
+    assert all(np.array_equal(a, b) for a, b in zip(runs[0], runs[1], strict=True))
+    assert all(np.array_equal(a, b) for a, b in zip(runs[0], runs[2], strict=True))
+    # truncated at steps 15 and 31 (step 16 is the autoreset): the run crosses episodes
+    assert runs[0][4 * 15].all() and runs[0][4 * 31].all()
+
+
+def test_threaded_step_refuses_a_bad_action_without_stepping_any_part() -> None:
+    venv = make_vec("shipgym/NomotoHeading-v0", 130, num_threads=1)
+    venv.task.num_threads = 3
+    venv.reset(seed=1)
+    state = venv.task.x.copy()
+    actions = np.zeros((130, 1))
+    actions[100] = np.nan  # in the last part
+    with pytest.raises(ValueError, match="sub-env 100's action holds NaN"):
+        venv.step(actions)
+    assert np.array_equal(venv.task.x, state)
 
 
 @pytest.mark.parametrize("bad", [0, -1, 10**6, 1.5, "2", True])

@@ -23,12 +23,12 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 import gymnasium as gym
-import numba
 import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from shipgym.envs import kernels
 from shipgym.envs.kernels import REASONS
 from shipgym.envs.streams import RowStreams
 from shipgym.envs.tasks import Task
@@ -212,9 +212,10 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         learner beside the env, a test suite, a sweep) a thread of a parallel step that the
         operating system deschedules holds up the whole step, and the parallel step becomes
         several times slower than the serial one (``shipgym bench --busy N`` measures it).
-        ``None`` uses every thread Numba has (``NUMBA_NUM_THREADS``, one per core), for
-        batches of at least 64 sub-envs on cores the env has to itself; results are bitwise
-        the same for every value.
+        ``None`` uses one thread per CPU the process may run on, for batches of at least 64
+        sub-envs on cores the env has to itself: the batch is split into that many contiguous
+        parts, each stepped by the same compiled kernel on its own thread (it releases the
+        GIL). Results are bitwise the same for every value.
     keep_options : bool
         What an autoreset does with the options of the last ``reset(options=...)``. False (the
         default, Gymnasium's ``SyncVectorEnv`` behaviour): an autoreset draws a fresh scenario
@@ -253,7 +254,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         num_threads: int | None = 1,
         **task_kwargs: Any,
     ) -> None:
-        max_threads = numba.config.NUMBA_NUM_THREADS
+        max_threads = kernels.available_threads()
         if num_threads is None:
             num_threads = max_threads
         if (
@@ -262,8 +263,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             or not 1 <= num_threads <= max_threads
         ):
             raise ValueError(
-                f"num_threads must be an integer in [1, {max_threads}] (NUMBA_NUM_THREADS) or "
-                f"None for all of them, got {num_threads!r}"
+                f"num_threads must be an integer in [1, {max_threads}] (the CPUs this process "
+                f"may run on) or None for all of them, got {num_threads!r}"
             )
         modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
         try:

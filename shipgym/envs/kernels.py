@@ -2,14 +2,14 @@
 
 One kernel per task family, looping over the rows of a batch. The single environment calls
 it with one row and the vector environment with many, so both run the same code and the same
-physics (:func:`shipgym.models.integrate.rk4_block`). Each kernel loops over chunks of rows;
-within a chunk it maps the actions and integrates a block of rows at once (the SIMD block
-step), then computes each row's observation, reward and termination while the block is in
-cache. Each is compiled twice from one source: serially and with a ``prange`` loop over
-chunks, which the vector env runs on ``num_threads`` threads; both give bit-identical
-results. Conventions: NED, heading clockwise from north, SI units and
-radians; the normalised action ``a`` is clipped to [-1, 1] and mapped to the model input by
-``u = u0 + B a``.
+physics (:func:`shipgym.models.integrate.rk4_block`). Each kernel loops over blocks of rows:
+it maps a block's actions and integrates its rows at once (the SIMD block step), then computes
+each row's observation, reward and termination while the block is in cache. A row's result
+does not depend on the other rows of the call, so the vector env steps a large batch on
+several threads by calling the kernel on a contiguous part of the rows from each
+(:func:`run_threaded`; the kernels release the GIL), with bit-identical results.
+Conventions: NED, heading clockwise from north, SI units and radians; the normalised action
+``a`` is clipped to [-1, 1] and mapped to the model input by ``u = u0 + B a``.
 
 Every task kernel returns the first row whose action is not finite (then nothing was
 stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps the whole
@@ -26,18 +26,20 @@ construction (each kernel's docstring gives the bounds; the tasks' ``reward_boun
 from __future__ import annotations
 
 import math
+import os
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import prange
 
-from shipgym.models._jit import kernel, parallel_kernel, row_kernel
+from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
 from shipgym.models.integrate import BLOCK, block_work, gather_rows, rk4_block, scatter_rows
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
-#: Rows per chunk of the (parallel) row loop; each chunk has its own RK4 scratch vectors.
-CHUNK = 256
+#: Batches at least this large are split over the threads of :func:`run_threaded`.
+THREADED_MIN_ROWS = 64
 REASONS = ("running", "numerical_blow_up", "success", "failure")
 
 
@@ -178,27 +180,24 @@ def _heading(
             return bad
     n_sp = schedule.shape[1]
     n_rows = rows.shape[0]
-    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1], n_rows)
-        ok, prev, cost = _row_work(obs.shape[1])
-        lo = chunk * CHUNK
-        hi = min(n_rows, lo + CHUNK)
-        for start in range(lo, hi, BLOCK):
-            m = min(BLOCK, hi - start)
-            if advance:
-                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            _begin_block(x, rows, start, m, ok, rew, term, reason)
-            _keep_block(obs, rows, start, m, a, prev, cost)
-            for b in range(m):
-                if ok[b]:
-                    i = rows[start + b]
-                    psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-                    e = ssa_scalar(psi_d - x[i, ipsi])
-                    obs[i, 0] = e
-                    for k in range(obs_idx.shape[0]):
-                        obs[i, 1 + k] = x[i, obs_idx[k]]
-                    rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+    work = block_work(x.shape[1], u.shape[1], n_rows)
+    ok, prev, cost = _row_work(obs.shape[1])
+    for start in range(0, n_rows, BLOCK):
+        m = min(BLOCK, n_rows - start)
+        if advance:
+            _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+        _begin_block(x, rows, start, m, ok, rew, term, reason)
+        _keep_block(obs, rows, start, m, a, prev, cost)
+        for b in range(m):
+            if ok[b]:
+                i = rows[start + b]
+                psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                e = ssa_scalar(psi_d - x[i, ipsi])
+                obs[i, 0] = e
+                for k in range(obs_idx.shape[0]):
+                    obs[i, 1 + k] = x[i, obs_idx[k]]
+                rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -237,32 +236,29 @@ def _speed(
     n_sp = schedule.shape[1]
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
-    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1], n_rows)
-        ok, prev, cost = _row_work(obs.shape[1])
-        lo = chunk * CHUNK
-        hi = min(n_rows, lo + CHUNK)
-        for start in range(lo, hi, BLOCK):
-            m = min(BLOCK, hi - start)
-            if advance:
-                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            _begin_block(x, rows, start, m, ok, rew, term, reason)
-            _keep_block(obs, rows, start, m, a, prev, cost)
-            for b in range(m):
-                if ok[b]:
-                    i = rows[start + b]
-                    psi = x[i, 2]
-                    ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
-                    ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-                    frac = x[i, 6] / tb
-                    obs[i, 0] = ud - ur
-                    obs[i, 1] = ur
-                    obs[i, 2] = frac
-                    obs[i, 3] = ud
-                    e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
-                    f = min(max(frac, obs_lo[2]), obs_hi[2])
-                    rew[i] = -abs(e) / 2.0 - 0.05 * f * f
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+    work = block_work(x.shape[1], u.shape[1], n_rows)
+    ok, prev, cost = _row_work(obs.shape[1])
+    for start in range(0, n_rows, BLOCK):
+        m = min(BLOCK, n_rows - start)
+        if advance:
+            _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+        _begin_block(x, rows, start, m, ok, rew, term, reason)
+        _keep_block(obs, rows, start, m, a, prev, cost)
+        for b in range(m):
+            if ok[b]:
+                i = rows[start + b]
+                psi = x[i, 2]
+                ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
+                ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
+                frac = x[i, 6] / tb
+                obs[i, 0] = ud - ur
+                obs[i, 1] = ur
+                obs[i, 2] = frac
+                obs[i, 3] = ud
+                e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
+                f = min(max(frac, obs_lo[2]), obs_hi[2])
+                rew[i] = -abs(e) / 2.0 - 0.05 * f * f
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -323,73 +319,83 @@ def _path(
             return bad
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
-    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1], n_rows)
-        ok, prev, cost = _row_work(obs.shape[1])
-        s_before = np.empty(BLOCK)
-        lo = chunk * CHUNK
-        hi = min(n_rows, lo + CHUNK)
-        for start in range(lo, hi, BLOCK):
-            m = min(BLOCK, hi - start)
-            for b in range(m):  # along-track distance left before the step
-                i = rows[start + b]
-                k = seg[i]
-                t = tangent[i, k]
-                s_before[b] = path_geometry(
-                    x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
-                )[1]
-            if advance:
-                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-            _begin_block(x, rows, start, m, ok, rew, term, reason)
-            _keep_block(obs, rows, start, m, a, prev, cost)
-            for b in range(m):
-                if not ok[b]:
-                    continue
-                i = rows[start + b]
-                k = seg[i]
-                t = tangent[i, k]
-                e, s_left = path_geometry(
-                    x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
-                )
-                progress = s_before[b] - s_left
-                dist_end = math.hypot(
-                    x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1]
-                )
-                bonus = 0.0
-                if dist_end < accept_radius or s_left < 0.0:
-                    if k + 2 < n_wp[i]:
-                        k += 1
-                        seg[i] = k
-                        t = tangent[i, k]
-                        e, s_left = path_geometry(
-                            x[i, 0], x[i, 1], t[0], t[1], t[2], t[3], leg_length[i, k]
-                        )
-                    else:
-                        term[i] = True
-                        reason[i] = SUCCESS
-                        bonus = 20.0
-                if abs(e) > max_cross_track:
+    work = block_work(x.shape[1], u.shape[1], n_rows)
+    ok, prev, cost = _row_work(obs.shape[1])
+    s_before = np.empty(BLOCK)
+    for start in range(0, n_rows, BLOCK):
+        m = min(BLOCK, n_rows - start)
+        for b in range(m):  # along-track distance left before the step
+            i = rows[start + b]
+            k = seg[i]
+            s_before[b] = path_geometry(
+                x[i, 0],
+                x[i, 1],
+                tangent[i, k, 0],
+                tangent[i, k, 1],
+                tangent[i, k, 2],
+                tangent[i, k, 3],
+                leg_length[i, k],
+            )[1]
+        if advance:
+            _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+        _begin_block(x, rows, start, m, ok, rew, term, reason)
+        _keep_block(obs, rows, start, m, a, prev, cost)
+        for b in range(m):
+            if not ok[b]:
+                continue
+            i = rows[start + b]
+            k = seg[i]
+            e, s_left = path_geometry(
+                x[i, 0],
+                x[i, 1],
+                tangent[i, k, 0],
+                tangent[i, k, 1],
+                tangent[i, k, 2],
+                tangent[i, k, 3],
+                leg_length[i, k],
+            )
+            progress = s_before[b] - s_left
+            dist_end = math.hypot(x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1])
+            bonus = 0.0
+            if dist_end < accept_radius or s_left < 0.0:
+                if k + 2 < n_wp[i]:
+                    k += 1
+                    seg[i] = k
+                    e, s_left = path_geometry(
+                        x[i, 0],
+                        x[i, 1],
+                        tangent[i, k, 0],
+                        tangent[i, k, 1],
+                        tangent[i, k, 2],
+                        tangent[i, k, 3],
+                        leg_length[i, k],
+                    )
+                else:
                     term[i] = True
-                    reason[i] = FAILURE
-                    bonus = -20.0
-                chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
-                obs[i, 0] = e
-                obs[i, 1] = chi_err
-                obs[i, 2] = s_left
-                obs[i, 3] = turn[i, k]
-                obs[i, 4] = x[i, 3]
-                obs[i, 5] = x[i, 4]
-                obs[i, 6] = x[i, 5]
-                obs[i, 7] = x[i, 8]
-                obs[i, 8] = x[i, 6] / tb
-                rew[i] = (
-                    0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
-                    + 0.5 * math.exp(-((e / 25.0) ** 2))
-                    - 0.1 * abs(chi_err) / math.pi
-                    - 0.05 * cost[b]
-                    + bonus
-                )
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+                    reason[i] = SUCCESS
+                    bonus = 20.0
+            if abs(e) > max_cross_track:
+                term[i] = True
+                reason[i] = FAILURE
+                bonus = -20.0
+            chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
+            obs[i, 0] = e
+            obs[i, 1] = chi_err
+            obs[i, 2] = s_left
+            obs[i, 3] = turn[i, k]
+            obs[i, 4] = x[i, 3]
+            obs[i, 5] = x[i, 4]
+            obs[i, 6] = x[i, 5]
+            obs[i, 7] = x[i, 8]
+            obs[i, 8] = x[i, 6] / tb
+            rew[i] = (
+                0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
+                + 0.5 * math.exp(-((e / 25.0) ** 2))
+                - 0.1 * abs(chi_err) / math.pi
+                - 0.05 * cost[b]
+                + bonus
+            )
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
@@ -430,58 +436,55 @@ def _target(
             return bad
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
-    for chunk in prange((n_rows + CHUNK - 1) // CHUNK):
-        work = block_work(x.shape[1], u.shape[1], n_rows)
-        ok, prev, cost = _row_work(obs.shape[1])
-        lo = chunk * CHUNK
-        hi = min(n_rows, lo + CHUNK)
-        for start in range(lo, hi, BLOCK):
-            m = min(BLOCK, hi - start)
-            if advance:
-                _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-                for b in range(m):
-                    i = rows[start + b]
-                    target[i, 0] += target_vel[i, 0] * dt
-                    target[i, 1] += target_vel[i, 1] * dt
-            _begin_block(x, rows, start, m, ok, rew, term, reason)
-            _keep_block(obs, rows, start, m, a, prev, cost)
+    work = block_work(x.shape[1], u.shape[1], n_rows)
+    ok, prev, cost = _row_work(obs.shape[1])
+    for start in range(0, n_rows, BLOCK):
+        m = min(BLOCK, n_rows - start)
+        if advance:
+            _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
             for b in range(m):
-                if not ok[b]:
-                    continue
                 i = rows[start + b]
-                psi = x[i, 2]
-                cs = math.cos(psi)
-                sn = math.sin(psi)
-                dn = target[i, 0] - x[i, 0]
-                de = target[i, 1] - x[i, 1]
-                vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
-                ve = sn * x[i, 3] + cs * x[i, 4]
-                rvn = target_vel[i, 0] - vn
-                rve = target_vel[i, 1] - ve
-                d = math.hypot(dn, de)
-                err = d - distance[i]
-                obs[i, 0] = cs * dn + sn * de
-                obs[i, 1] = -sn * dn + cs * de
-                obs[i, 2] = cs * rvn + sn * rve
-                obs[i, 3] = -sn * rvn + cs * rve
-                obs[i, 4] = err
-                obs[i, 5] = x[i, 3]
-                obs[i, 6] = x[i, 4]
-                obs[i, 7] = x[i, 5]
-                obs[i, 8] = x[i, 8]
-                obs[i, 9] = x[i, 6] / tb
-                rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * cost[b]
-                if d > max_distance:
-                    term[i] = True
-                    reason[i] = FAILURE
-                    rew[i] -= 20.0
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+                target[i, 0] += target_vel[i, 0] * dt
+                target[i, 1] += target_vel[i, 1] * dt
+        _begin_block(x, rows, start, m, ok, rew, term, reason)
+        _keep_block(obs, rows, start, m, a, prev, cost)
+        for b in range(m):
+            if not ok[b]:
+                continue
+            i = rows[start + b]
+            psi = x[i, 2]
+            cs = math.cos(psi)
+            sn = math.sin(psi)
+            dn = target[i, 0] - x[i, 0]
+            de = target[i, 1] - x[i, 1]
+            vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
+            ve = sn * x[i, 3] + cs * x[i, 4]
+            rvn = target_vel[i, 0] - vn
+            rve = target_vel[i, 1] - ve
+            d = math.hypot(dn, de)
+            err = d - distance[i]
+            obs[i, 0] = cs * dn + sn * de
+            obs[i, 1] = -sn * dn + cs * de
+            obs[i, 2] = cs * rvn + sn * rve
+            obs[i, 3] = -sn * rvn + cs * rve
+            obs[i, 4] = err
+            obs[i, 5] = x[i, 3]
+            obs[i, 6] = x[i, 4]
+            obs[i, 7] = x[i, 5]
+            obs[i, 8] = x[i, 8]
+            obs[i, 9] = x[i, 6] / tb
+            rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * cost[b]
+            if d > max_distance:
+                term[i] = True
+                reason[i] = FAILURE
+                rew[i] -= 20.0
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
     return -1
 
 
-#: (serial, parallel) compilations of each task kernel, chosen by batch size.
+#: The task kernel of each task family.
 KERNELS = {
-    name: (kernel(func), parallel_kernel(func))
+    name: kernel(func)
     for name, func in (
         ("heading", _heading),
         ("speed", _speed),
@@ -489,3 +492,32 @@ KERNELS = {
         ("target", _target),
     )
 }
+
+
+def available_threads() -> int:
+    """Threads a batch can be stepped on: the CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+_POOL: list[ThreadPoolExecutor] = []
+
+
+def run_threaded(
+    task_kernel: Callable[..., int], threads: int, advance: bool, rows: np.ndarray, *args: object
+) -> int:
+    """Call ``task_kernel`` on ``threads`` contiguous parts of ``rows`` at once: the calling
+    thread steps the first part, threads of a shared pool the others.
+
+    The result is bitwise that of one call on all rows (each row's result depends on that row
+    only). Returns the kernel's result: the first row whose action is not finite (every part
+    checks all actions, so then no part steps), or -1.
+    """
+    if not _POOL:
+        _POOL.append(ThreadPoolExecutor(available_threads(), thread_name_prefix="shipgym-step"))
+    parts = np.array_split(rows, threads)
+    futures = [_POOL[0].submit(task_kernel, advance, part, *args) for part in parts[1:]]
+    bad = [task_kernel(advance, parts[0], *args)] + [f.result() for f in futures]
+    return max(bad)

@@ -35,18 +35,17 @@ significant digits the messages show.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
-import numba
 import numpy as np
 
 from shipgym.envs import kernels
 from shipgym.envs.streams import RowStreams
 from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
 from shipgym.models.angles import ssa
-from shipgym.models.integrate import PARALLEL_MIN_ROWS
 from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
 
 COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
@@ -264,20 +263,10 @@ class Task:
     num_threads: int = 1
 
     def _kernel(self, n: int) -> Any:
-        serial, parallel = kernels.KERNELS[self.kernel_name]
-        if self.num_threads == 1 or n < PARALLEL_MIN_ROWS:
+        serial = kernels.KERNELS[self.kernel_name]
+        if self.num_threads == 1 or n < kernels.THREADED_MIN_ROWS:
             return serial
-        threads = self.num_threads
-
-        def run(*args: Any) -> Any:
-            before = numba.get_num_threads()  # a per-thread setting: restored after the call
-            numba.set_num_threads(threads)
-            try:
-                return parallel(*args)
-            finally:
-                numba.set_num_threads(before)
-
-        return run
+        return functools.partial(kernels.run_threaded, serial, self.num_threads)
 
     def _args(self, advance: bool, rows: np.ndarray) -> tuple[Any, ...]:
         m = self.model

@@ -23,7 +23,6 @@ from __future__ import annotations
 import glob
 import hashlib
 import os
-import types
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -137,23 +136,3 @@ def simd_kernel(func: F) -> F:
     vectorising it.
     """
     return _compile(func, nogil=True, error_model="numpy", forceinline=True)
-
-
-def parallel_kernel(func: F) -> F:
-    """Compile a batch kernel whose ``prange`` loops run on all cores.
-
-    The function is compiled under its own name (``<name>_parallel``): Numba's cache index is
-    keyed by the function's name and signature but not by ``parallel``, so a serial and a
-    parallel compilation of one function would otherwise overwrite and load each other.
-    """
-    clone = types.FunctionType(
-        func.__code__,
-        func.__globals__,
-        func.__name__ + "_parallel",
-        func.__defaults__,
-        func.__closure__,
-    )
-    clone.__qualname__ = func.__qualname__ + "_parallel"
-    clone.__module__ = func.__module__
-    clone.__doc__ = func.__doc__
-    return _compile(clone, nogil=True, parallel=True)  # type: ignore[arg-type]

@@ -233,10 +233,6 @@ def rk4_stages(deriv, model_id, x, u, p, c, h, i, k1, k2, k3, k4, t):
         xi[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
 
 
-#: Batches at least this large are stepped by the parallel compilation of the env kernels.
-PARALLEL_MIN_ROWS = 64
-
-
 @kernel
 def rk4_step_kernel(model_id, x, u, p, c, h):
     """Advance every row of ``x`` in place by one RK4 step of length ``h`` [s] (unchecked: see
