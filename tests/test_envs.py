@@ -1,7 +1,7 @@
 """Tests of the Gymnasium environments of :mod:`shipgym.envs` (single and vector).
 
 Covers the Gymnasium API (``check_env``), seeding and determinism, the equivalence of the
-NumPy-batched vector environments with the single environments (serial and parallel kernel,
+NumPy-batched vector environments with the single environments (one thread and several,
 next-step autoreset), pickling, reset options, input validation, numerical blow-ups,
 rendering and the contents of ``info``.
 """
@@ -1016,9 +1016,7 @@ def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
     threads = kernels.available_threads()
     runs = []
     for count in (1, None, 3):
-        venv = make_vec(
-            env_id, 130, num_threads=1 if count == 3 else count, max_episode_steps=15
-        )
+        venv = make_vec(env_id, 130, num_threads=1 if count == 3 else count, max_episode_steps=15)
         assert venv.num_threads == (threads if count is None else 1)
         if count == 3:  # three parts of 44, 43 and 43 rows, whatever the machine has
             venv.task.num_threads = 3

@@ -209,9 +209,9 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     num_threads : int or None
         Threads that step the batch. 1 (the default) steps it on the calling thread, which is
         the fastest choice whenever the cores are shared: with other busy processes (an RL
-        learner beside the env, a test suite, a sweep) a thread of a parallel step that the
-        operating system deschedules holds up the whole step, and the parallel step becomes
-        several times slower than the serial one (``shipgym bench --busy N`` measures it).
+        learner beside the env, a test suite, a sweep) a thread of a threaded step that the
+        operating system deschedules holds up the whole step, and the threaded step becomes
+        slower than the serial one (``shipgym bench --busy N`` measures it).
         ``None`` uses one thread per CPU the process may run on, for batches of at least 64
         sub-envs on cores the env has to itself: the batch is split into that many contiguous
         parts, each stepped by the same compiled kernel on its own thread (it releases the
