@@ -1,10 +1,12 @@
 """Test-session setup: the run's temporary files live in one folder, removed at the end.
 
 ``TMPDIR`` (for subprocesses), :data:`tempfile.tempdir` and pytest's ``tmp_path`` base all point
-into a fresh folder for the session. Whatever the code under test leaves there outside pytest's
-own ``tmp_path`` folders (an ``SB3-<date>`` logger folder, a temporary file not cleaned up) fails
-the run with the names of what was left; the folder is removed either way, so a test run leaves
-nothing in the system's temporary directory. Torch runs on one thread (tiny networks).
+into a fresh folder for the session; the pytest-xdist workers share the folder of the process
+that started them (their ``tmp_path`` bases are ``pytest/gw<N>`` in it). Whatever the code under
+test leaves there outside pytest's own ``tmp_path`` folders (an ``SB3-<date>`` logger folder, a
+temporary file not cleaned up) fails the run with the names of what was left; the folder is
+removed either way, so a test run leaves nothing in the system's temporary directory. Torch runs
+on one thread (tiny networks).
 """
 
 from __future__ import annotations
@@ -16,17 +18,29 @@ from pathlib import Path
 
 import pytest
 
-_ROOT = Path(tempfile.mkdtemp(prefix="shipgym-tests-"))
+#: the session's folder, made by the process that runs pytest and shared by its xdist workers
+_ROOT_VARIABLE = "SHIPGYM_TEST_ROOT"
 _PYTEST_DIR = "pytest"
 #: torch makes its compiler cache folder ``torchinductor_<user>`` in the temporary directory
 #: when an optimiser is built; that is torch's cache, not a file a run forgot
 _THIRD_PARTY_CACHES = ("torchinductor_",)
 
 
+def _is_worker(config: pytest.Config) -> bool:
+    return hasattr(config, "workerinput")  # a pytest-xdist worker
+
+
+def _root() -> Path:
+    return Path(os.environ[_ROOT_VARIABLE])
+
+
 def pytest_configure(config: pytest.Config) -> None:
-    config.option.basetemp = str(_ROOT / _PYTEST_DIR)
-    os.environ["TMPDIR"] = str(_ROOT)
-    tempfile.tempdir = str(_ROOT)
+    if not _is_worker(config):  # the workers get their tmp_path base from xdist, inside it
+        root = Path(tempfile.mkdtemp(prefix="shipgym-tests-"))
+        os.environ[_ROOT_VARIABLE] = str(root)
+        config.option.basetemp = str(root / _PYTEST_DIR)
+    os.environ["TMPDIR"] = str(_root())
+    tempfile.tempdir = str(_root())
     # the tests' networks are tiny: torch's thread pool only adds synchronisation, and on
     # shared cores (a loaded CI machine) it makes each layer several times slower
     os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -38,9 +52,11 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if _is_worker(session.config):  # checked once, by the process that started the workers
+        return
     left = sorted(
         p.name
-        for p in _ROOT.iterdir()
+        for p in _root().iterdir()
         if p.name != _PYTEST_DIR and not p.name.startswith(_THIRD_PARTY_CACHES)
     )
     if left:
@@ -53,4 +69,5 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    shutil.rmtree(_ROOT, ignore_errors=True)
+    if not _is_worker(config) and _ROOT_VARIABLE in os.environ:
+        shutil.rmtree(_root(), ignore_errors=True)

@@ -28,6 +28,9 @@ from shipgym.benchmark.throughput import CARTPOLE, ppo_throughput
 from shipgym.cli import main
 from shipgym.rl.train import BENCHMARK_SEED
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_benchmark")
+
 ENV = "shipgym/RVGHeading-v1"
 CONDITIONS = ("nominal", "stress", "noise", "delay")
 

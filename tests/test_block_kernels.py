@@ -24,6 +24,9 @@ from shipgym.models import make_model
 from shipgym.models.integrate import BLOCK
 from shipgym.models.vmath import atan2, sincos
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_block_kernels")
+
 REFERENCE = Path(__file__).parent / "data" / "step_reference.npz"
 
 

@@ -22,6 +22,9 @@ from shipgym.cli import main
 from shipgym.cluster import parse_address, ray_session
 from shipgym.rl.train import BENCHMARK_SEED
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_cluster")
+
 ENV = "shipgym/RVGHeading-v1"  # the shortest episodes (600 steps)
 
 

@@ -32,6 +32,9 @@ from shipgym.envs import ENV_IDS
 from shipgym.envs.tasks import COMMON_OPTIONS
 from shipgym.sysid import load
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_properties")
+
 SETTINGS = settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow], database=None
 )

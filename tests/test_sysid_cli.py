@@ -19,6 +19,9 @@ from shipgym.sysid.engine import IdentificationResult
 from shipgym.sysid.generator import generate_record
 from shipgym.sysid.plots import MAX_WINDOW_LINES, plot_identification
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_sysid_cli")
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 JSON_KEYS = {
     "model",

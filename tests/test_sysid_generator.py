@@ -37,6 +37,9 @@ from shipgym.sysid.generator import (
     generate_record,
 )
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_sysid_generator")
+
 _BASE = Nomoto1Params()
 _NOMOTO_EFFECTS = EFFECTS_BY_BASE["nomoto1"]
 _RVG_EFFECTS = EFFECTS_BY_BASE["rvg3dof"]

@@ -12,6 +12,9 @@ import pytest
 from shipgym.sysid import manoeuvres as mv
 from shipgym.sysid.data import Record, SysidDataWarning, load
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_sysid_manoeuvres")
+
 MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
 GUNNERUS = MEASURED / "gunnerus_seatrials" / "RVG_ManeuveringTests.csv"
 needs_data = pytest.mark.skipif(not GUNNERUS.is_file(), reason=f"measured data not at {GUNNERUS}")

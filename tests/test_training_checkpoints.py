@@ -32,6 +32,9 @@ from shipgym.rl.agents import load_agent
 from shipgym.rl.sweep import HYPERPARAMETERS, load_sweep, run_sweep
 from shipgym.rl.train import resume, train
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_training_checkpoints")
+
 ENV = "shipgym/RVGSpeed-v1"
 NAME = "RVGSpeed-v1-ppo"
 TINY = {"n_steps": 64, "batch_size": 64, "n_epochs": 1, "policy_kwargs": {"net_arch": [16]}}

@@ -27,6 +27,9 @@ from shipgym.sysid import identify, load
 from shipgym.sysid.families.vmm import prepare_runs, regress, vessel_params
 from shipgym.sysid.generator import generate_vmm_runs, vmm_truth
 
+# one worker runs this file: its module fixtures are built once (pytest-xdist)
+pytestmark = pytest.mark.xdist_group("test_vmm")
+
 MEASURED = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
 HSVA = sorted((MEASURED / "hsva_kvlcc2").glob("*.dat"))
 
