@@ -83,13 +83,21 @@ def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, wo
 
 
 @row_kernel
-def _begin_block(x, rows, start, n, ok, rew, term, reason):
-    """Clear the flags of rows ``rows[start .. start + n - 1]``; ``ok[b]`` False (and the row
-    terminated with a blow-up) where the state of the ``b``-th is not finite."""
+def _begin_block(x, obs, a, rows, start, n, ok, prev, cost, rew, term, reason):
+    """Start the row logic of rows ``rows[start .. start + n - 1]``: clear their flags, keep
+    their observations in ``prev`` (before they are recomputed) and the squared norm of their
+    actions in ``cost``; ``ok[b]`` False (and the row terminated with a blow-up) where the state
+    of the ``b``-th is not finite."""
     for b in range(n):
         i = rows[start + b]
         reason[i] = RUNNING
         term[i] = False
+        for k in range(obs.shape[1]):
+            prev[b, k] = obs[i, k]
+        s = 0.0
+        for k in range(a.shape[1]):
+            s += a[i, k] * a[i, k]
+        cost[b] = s
         finite = True
         for j in range(x.shape[1]):
             finite &= math.isfinite(x[i, j])
@@ -98,20 +106,6 @@ def _begin_block(x, rows, start, n, ok, rew, term, reason):
             rew[i] = 0.0
             term[i] = True
             reason[i] = BLOW_UP
-
-
-@row_kernel
-def _keep_block(obs, rows, start, n, a, prev, cost):
-    """Copy the observations of the block's rows into ``prev`` before they are recomputed, and
-    put the squared norm of each row's action into ``cost``."""
-    for b in range(n):
-        i = rows[start + b]
-        for k in range(obs.shape[1]):
-            prev[b, k] = obs[i, k]
-        s = 0.0
-        for k in range(a.shape[1]):
-            s += a[i, k] * a[i, k]
-        cost[b] = s
 
 
 @row_kernel
@@ -186,8 +180,7 @@ def _heading(
         m = min(BLOCK, n_rows - start)
         if advance:
             _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-        _begin_block(x, rows, start, m, ok, rew, term, reason)
-        _keep_block(obs, rows, start, m, a, prev, cost)
+        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if ok[b]:
                 i = rows[start + b]
@@ -242,8 +235,7 @@ def _speed(
         m = min(BLOCK, n_rows - start)
         if advance:
             _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-        _begin_block(x, rows, start, m, ok, rew, term, reason)
-        _keep_block(obs, rows, start, m, a, prev, cost)
+        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if ok[b]:
                 i = rows[start + b]
@@ -338,8 +330,7 @@ def _path(
             )[1]
         if advance:
             _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
-        _begin_block(x, rows, start, m, ok, rew, term, reason)
-        _keep_block(obs, rows, start, m, a, prev, cost)
+        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if not ok[b]:
                 continue
@@ -446,8 +437,7 @@ def _target(
                 i = rows[start + b]
                 target[i, 0] += target_vel[i, 0] * dt
                 target[i, 1] += target_vel[i, 1] * dt
-        _begin_block(x, rows, start, m, ok, rew, term, reason)
-        _keep_block(obs, rows, start, m, a, prev, cost)
+        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if not ok[b]:
                 continue
