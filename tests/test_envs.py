@@ -1033,6 +1033,31 @@ def test_vector_env_threads_give_bitwise_the_same_run(env_id: str) -> None:
     assert runs[0][4 * 15].all() and runs[0][4 * 31].all()
 
 
+def _step_in_child(venv: VectorEnv, queue: Any) -> None:
+    venv.step(np.zeros(venv.action_space.shape))
+    queue.put(venv.unwrapped.task.steps.sum())
+
+
+def test_threaded_step_works_in_a_forked_child() -> None:
+    """A process forked after a threaded step has none of the step's pool threads: its steps
+    make their own (before, they would wait for the parent's threads for ever)."""
+    import multiprocessing
+
+    venv = make_vec("shipgym/NomotoHeading-v0", 130, num_threads=1)
+    venv.task.num_threads = 2
+    venv.reset(seed=3)
+    venv.step(np.zeros(venv.action_space.shape))  # the pool exists in this process now
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    child = ctx.Process(target=_step_in_child, args=(venv, queue))
+    child.start()
+    child.join(timeout=60)
+    stuck = child.is_alive()
+    child.kill()
+    assert not stuck and child.exitcode == 0
+    assert queue.get(timeout=5) == 2 * 130
+
+
 def test_threaded_step_refuses_a_bad_action_without_stepping_any_part() -> None:
     venv = make_vec("shipgym/NomotoHeading-v0", 130, num_threads=1)
     venv.task.num_threads = 3

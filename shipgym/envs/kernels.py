@@ -493,6 +493,8 @@ def available_threads() -> int:
 
 
 _POOL: list[ThreadPoolExecutor] = []
+# a forked child has none of the pool's threads: it makes its own pool when it needs one
+os.register_at_fork(after_in_child=_POOL.clear)
 
 
 def run_threaded(
