@@ -51,12 +51,6 @@ def pytest_configure(config: pytest.Config) -> None:
     torch.set_num_threads(1)
 
 
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """The files run as one xdist group each (those whose module fixtures train, fit or start
-    Ray, the longest units of work) first, so that the workers finish together."""
-    items.sort(key=lambda item: item.get_closest_marker("xdist_group") is None)  # stable
-
-
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if _is_worker(session.config):  # checked once, by the process that started the workers
         return
