@@ -28,8 +28,7 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from shipgym.envs import kernels
-from shipgym.envs.kernels import REASONS
+from shipgym.envs.kernels import REASONS, available_threads
 from shipgym.envs.streams import RowStreams
 from shipgym.envs.tasks import Task
 
@@ -254,7 +253,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         num_threads: int | None = 1,
         **task_kwargs: Any,
     ) -> None:
-        max_threads = kernels.available_threads()
+        max_threads = available_threads()
         if num_threads is None:
             num_threads = max_threads
         if (

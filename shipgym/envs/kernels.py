@@ -135,7 +135,7 @@ def _finish_block(obs, rows, start, n, ok, lo, hi, prev, rew, term, reason):
 
 @row_kernel
 def _row_work(obs_dim):
-    """Per-chunk scratch of the row logic: ``ok``, ``prev`` and ``cost`` of one block."""
+    """Scratch of the row logic of one block: ``ok``, ``prev`` and ``cost``."""
     return np.empty(BLOCK, dtype=np.bool_), np.empty((BLOCK, obs_dim)), np.empty(BLOCK)
 
 
