@@ -17,7 +17,8 @@ Subcommands::
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
                       [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]
                       [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N] [--no-throughput]
-    shipgym identify PATH [--format F] [--model nomoto1|nomoto2|norrbin|bech|rvg3dof]
+    shipgym identify PATH [--format F] [--columns MAP] [--max-gap S]
+                     [--model nomoto1|nomoto2|norrbin|bech|rvg3dof|vmm:...|kvlcc2]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
 
@@ -1524,7 +1525,12 @@ def _table(rows: Sequence[tuple[str, ...]], indent: str = "  ") -> list[str]:
 
 
 def _load_for_identify(
-    path_text: str, fmt: str | None, note: Callable[[str], None], quiet: bool = False
+    path_text: str,
+    fmt: str | None,
+    note: Callable[[str], None],
+    quiet: bool = False,
+    columns: str | None = None,
+    max_gap_s: float | None = None,
 ) -> Any:
     """Load the record; repairs (:class:`SysidDataWarning`) and other warnings become notes.
 
@@ -1541,6 +1547,10 @@ def _load_for_identify(
         )
     if not path.is_file():
         raise ValueError(f"{path_text!r} is not a file (expected a measured-data record file)")
+    if columns is not None:
+        if fmt not in (None, "table"):
+            raise ValueError(f"--columns goes with --format table, not --format {fmt}")
+        fmt = "table"
     if fmt is None:
         try:
             fmt = detect_format(path)
@@ -1550,7 +1560,13 @@ def _load_for_identify(
             ) from None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        record = load(path, fmt, progress=False if quiet else None)
+        record = load(
+            path,
+            fmt,
+            progress=False if quiet else None,
+            columns=columns,
+            max_gap_s=max_gap_s,
+        )
     messages = [str(w.message) for w in caught]
     for msg in messages:
         note(msg)
@@ -1584,7 +1600,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     records, sources = [], []
     for path_text in args.path:
         say(f"loading {path_text} ...")
-        record, fmt = _load_for_identify(path_text, args.format, note, args.quiet)
+        record, fmt = _load_for_identify(
+            path_text, args.format, note, args.quiet, args.columns, args.max_gap
+        )
         chans = " ".join(k for k in record.channels() if k != "time")
         sources.append(
             f"{path_text} ({fmt}, {record.n} samples, {record.duration:g} s at dt "
@@ -1671,7 +1689,25 @@ def _build_identify(sub: Any) -> None:
         "--format",
         default=None,
         choices=FORMATS,
-        help="file format (default: detected from the header and the file name)",
+        help="file format (default: detected from the header and the file name; 'table' is "
+        "any delimited file whose headers state their units, 'nmea' an NMEA 0183 log)",
+    )
+    p.add_argument(
+        "--columns",
+        default=None,
+        metavar="MAP",
+        help="column map of your own table, e.g. 'time=t,delta=-rudder:deg,psi=hdg:deg,"
+        "r=rot:deg/min,U=sog:kn' (channel=[-]column:unit; '-' negates a port-positive rudder "
+        "or a counter-clockwise heading; channels time, delta, psi, r, U, u, v, x, y, lat, "
+        "lon, rpm)",
+    )
+    p.add_argument(
+        "--max-gap",
+        type=_float_in(1e-6, 1e6, "s"),
+        default=None,
+        metavar="S",
+        help="table and nmea: a longer time step splits the record into segments (default: "
+        "5 median steps)",
     )
     p.add_argument(
         "--model", default="nomoto1", choices=tuple(FAMILIES), help="base model (%(default)s)"

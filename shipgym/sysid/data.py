@@ -143,7 +143,7 @@ import re
 import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -166,8 +166,20 @@ __all__ = [
     "wrap_angle",
 ]
 
-FORMATS: tuple[str, ...] = ("sspa", "marin", "hsva", "esso_osaka", "usv", "gunnerus", "canonical")
-"""Accepted values of ``format`` in :func:`load`."""
+FORMATS: tuple[str, ...] = (
+    "sspa",
+    "marin",
+    "hsva",
+    "esso_osaka",
+    "usv",
+    "gunnerus",
+    "canonical",
+    "table",
+    "nmea",
+)
+"""Accepted values of ``format`` in :func:`load`: the six measured sources, the canonical CSV,
+any delimited ``table`` with a column map or unit-stating headers
+(:mod:`shipgym.sysid.table`) and NMEA 0183 logs (:mod:`shipgym.sysid.nmea`)."""
 
 HEADING_GLITCH_TOL: float = math.radians(4.0)
 """Smallest tolerance [rad] for the disagreement between one heading increment and the
@@ -232,6 +244,7 @@ _META_STR_KEYS = (
     "licence",
     "r_source",
     "maneuver",
+    "start_time",
 )
 _META_LIST_KEYS = ("conversions", "repairs", "notes")
 _META_NUMBER_KEYS = (
@@ -271,6 +284,16 @@ def _meta_expected(key: str, value: Any) -> str | None:
     elif key == "particulars":
         if not isinstance(value, dict):
             return "a JSON object"
+    elif key == "segments":
+        if not (
+            isinstance(value, list)
+            and value
+            and all(
+                isinstance(v, list) and len(v) == 2 and all(map(_is_number, v)) and v[0] < v[1]
+                for v in value
+            )
+        ):
+            return "a JSON list of [t0, t1] spans with t0 < t1, e.g. [[0, 120.5], [180, 600]]"
     return None
 
 
@@ -458,6 +481,73 @@ class Record:
     def _replace(self, channels: dict[str, np.ndarray], meta: dict[str, Any]) -> Record:
         return Record(**channels, meta=meta)
 
+    @classmethod
+    def from_arrays(
+        cls,
+        *,
+        time: Any,
+        delta: Any,
+        psi: Any,
+        r: Any = None,
+        U: Any = None,
+        x: Any = None,
+        y: Any = None,
+        lat: Any = None,
+        lon: Any = None,
+        u: Any = None,
+        v: Any = None,
+        rpm: Any = None,
+        units: Mapping[str, str] | None = None,
+        meta: Mapping[str, Any] | None = None,
+        max_gap_s: float | None = None,
+    ) -> Record:
+        """A record from arrays of a ship's own log, in any of the units of a column map.
+
+        The arrays go through the processing of a loaded table (:mod:`shipgym.sysid.table`):
+        units to SI and radians, gaps split into segments, unit checks, heading unwrapped and
+        repaired, yaw rate derived from the heading when ``r`` is None, neutral rudder
+        measured.
+
+        Parameters
+        ----------
+        time : array_like
+            Time in ``units["time"]`` (``"s"`` by default; ``"ms"``, ``"min"``, ``"h"``, or
+            ``"datetime"`` for numpy datetime64 values or ISO-8601 strings).
+        delta, psi : array_like
+            Rudder (positive turns to starboard) and heading (clockwise from north); radians
+            unless ``units`` says ``"deg"``.
+        r, U, x, y, lat, lon, u, v, rpm : array_like, optional
+            Yaw rate (clockwise), speed, north/east position, latitude/longitude [deg] (instead
+            of x, y), body surge/sway, propeller speed.
+        units : mapping, optional
+            Channel -> unit of :data:`shipgym.sysid.table.UNITS` (``{"psi": "deg", "r":
+            "deg/min", "U": "kn"}``); channels not named are SI.
+        meta : mapping, optional
+            Merged into the record's meta (``source``, ``vessel``, ``L`` ...).
+        max_gap_s : float, optional
+            Longest time step [s] inside a segment (default: 5 median steps); a sample with a
+            NaN is a gap as well.
+        """
+        from shipgym.sysid.table import record_from_arrays
+
+        given = {"time": time, "delta": delta, "psi": psi, "r": r, "U": U, "x": x, "y": y}
+        given.update(lat=lat, lon=lon, u=u, v=v, rpm=rpm)
+        arrays = {k: val for k, val in given.items() if val is not None}
+        return record_from_arrays(arrays, units=units, meta=meta, max_gap_s=max_gap_s)
+
+    def segments(self) -> list[Record]:
+        """The record's stretches between gaps (``meta["segments"]``), or ``[self]``."""
+        spans = self.meta.get("segments")
+        if not spans:
+            return [self]
+        out = []
+        for t0, t1 in spans:
+            mask = (self.time >= t0) & (self.time <= t1)
+            meta = {k: val for k, val in self.meta.items() if k != "segments"}
+            meta["slice_s"] = [float(t0), float(t1)]
+            out.append(self._replace({k: a[mask] for k, a in self.channels().items()}, meta))
+        return out
+
     # -- selection and resampling --------------------------------------------------------------
     def slice(self, t0: float, t1: float) -> Record:
         """Samples with ``t0 <= time <= t1`` as a new Record (``meta["slice_s"] = [t0, t1]``).
@@ -477,6 +567,12 @@ class Record:
             )
         meta = dict(self.meta)
         meta["slice_s"] = [float(t0), float(t1)]
+        if meta.get("segments"):
+            kept = [[max(a, t0), min(b, t1)] for a, b in meta["segments"] if b > t0 and a < t1]
+            if len(kept) > 1:
+                meta["segments"] = kept
+            else:
+                del meta["segments"]
         return self._replace({k: v[mask] for k, v in self.channels().items()}, meta)
 
     def resample(self, dt: float) -> Record:
@@ -497,6 +593,14 @@ class Record:
         """
         if not (np.isfinite(dt) and dt > 0.0):
             raise ValueError(f"resample dt must be a positive finite time step in s, got {dt!r}")
+        if self.meta.get("segments"):  # each segment on its own grid, never across a gap
+            parts = [seg.resample(dt) for seg in self.segments()]
+            meta = dict(self.meta)
+            meta["segments"] = [[float(p.time[0]), float(p.time[-1])] for p in parts]
+            meta["resampled_dt"] = float(dt)
+            meta.pop("irregular_sampling", None)
+            chans = {k: np.concatenate([getattr(p, k) for p in parts]) for k in self.channels()}
+            return self._replace(chans, meta)
         if dt >= self.duration:
             raise ValueError(
                 f"resample dt={dt} s must be smaller than the record duration {self.duration} s"
@@ -1577,7 +1681,19 @@ def _load_canonical(path: Path, say: Callable[[str], None] = _silent) -> Record:
     return Record(**chans, meta=meta)
 
 
-_LOADERS = {
+def _load_table(path: Path, say: Callable[[str], None] = _silent, **kw: Any) -> Record:
+    from shipgym.sysid.table import load_table
+
+    return load_table(path, say, **kw)
+
+
+def _load_nmea(path: Path, say: Callable[[str], None] = _silent, **kw: Any) -> Record:
+    from shipgym.sysid.nmea import load_nmea
+
+    return load_nmea(path, say, **kw)
+
+
+_LOADERS: dict[str, Callable[..., Record]] = {
     "sspa": _load_sspa,
     "marin": _load_marin,
     "hsva": _load_hsva,
@@ -1585,6 +1701,8 @@ _LOADERS = {
     "usv": _load_usv,
     "gunnerus": _load_gunnerus,
     "canonical": _load_canonical,
+    "table": _load_table,
+    "nmea": _load_nmea,
 }
 
 
@@ -1639,11 +1757,31 @@ def detect_format(path: str | Path) -> str:
         return by_folder[parent]
     if path.parent.parent.name.lower() == "esso_osaka_frt":
         return "esso_osaka"
+    if _NMEA_SENTENCE.search(first):
+        return "nmea"
+    if _looks_like_table(head):
+        return "table"
     reason = "the file is empty" if not first else f"first line {first[:80]!r}"
     raise ValueError(
         f"cannot detect the format of {path.name} ({reason}); accepted formats: "
         f"{', '.join(FORMATS)} (pass format=...)"
     )
+
+
+#: An NMEA 0183 sentence (``$HEHDT,...``, ``!AIVDM,...``), possibly after a logger's time stamp.
+_NMEA_SENTENCE = re.compile(r"[$!][A-Z][A-Z0-9]{4},")
+
+
+def _looks_like_table(head: str) -> bool:
+    """A header and a data row that split into the same two or more fields."""
+    lines = [ln for ln in head.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if len(lines) < 2:
+        return False
+    for sep in (",", ";", "\t", None):
+        n = len(lines[0].split(sep))
+        if n >= 2 and len(lines[1].split(sep)) == n:
+            return True
+    return False
 
 
 def progress_printer(progress: ProgressArg) -> Callable[[str], None]:
@@ -1674,14 +1812,14 @@ def _progress_printer(path: Path, progress: ProgressArg) -> Callable[[str], None
     return progress_printer(progress)
 
 
-def _load_with_progress(path: Path, format: str, progress: ProgressArg = None) -> Record:
+def _load_with_progress(path: Path, format: str, progress: ProgressArg = None, **kw: Any) -> Record:
     """Run the loader of ``format`` with progress lines and the large-record warning."""
     say = _progress_printer(path, progress)
     t0 = time.perf_counter()
     size = path.stat().st_size
     if say is not _silent:
         say(f"loading {path.name} ({size / 1e6:.1f} MB, format {format}) ...")
-    record = _LOADERS[format](path, say)
+    record = _LOADERS[format](path, say, **kw)
     if record.n > LARGE_RECORD_SAMPLES:
         warnings.warn(
             f"{path.name}: large record of {record.n:,} samples ({size / 1e6:.0f} MB, "
@@ -1697,7 +1835,14 @@ def _load_with_progress(path: Path, format: str, progress: ProgressArg = None) -
     return record
 
 
-def load(path: str | Path, format: str | None = None, *, progress: ProgressArg = None) -> Record:
+def load(
+    path: str | Path,
+    format: str | None = None,
+    *,
+    progress: ProgressArg = None,
+    columns: str | Mapping[str, str] | None = None,
+    max_gap_s: float | None = None,
+) -> Record:
     """Load one measured-data file into a canonical :class:`Record`.
 
     Parameters
@@ -1710,6 +1855,13 @@ def load(path: str | Path, format: str | None = None, *, progress: ProgressArg =
         Where one-line progress messages go while loading (a callable taking the line, a text
         file, True for stderr, False for none). None (default): stderr for files larger than
         :data:`PROGRESS_FILE_BYTES`, nothing for smaller ones.
+    columns : str or mapping, optional
+        A column map for a ship's own table (format ``table``, implied):
+        ``"time=t,delta=-rudder:deg,psi=hdg:deg,r=rot:deg/min,U=sog:kn"``
+        (:func:`shipgym.sysid.table.parse_columns`).
+    max_gap_s : float, optional
+        Formats ``table`` and ``nmea``: the longest time step [s] inside a segment (a longer
+        one splits the record into ``meta["segments"]``).
 
     Returns
     -------
@@ -1732,11 +1884,22 @@ def load(path: str | Path, format: str | None = None, *, progress: ProgressArg =
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{path} is not a file")
+    if columns is not None:
+        if format not in (None, "table"):
+            raise ValueError(f"a column map goes with format 'table', not {format!r}")
+        format = "table"
     if format is None:
         format = detect_format(path)
     if format not in _LOADERS:
         raise ValueError(f"unknown format {format!r}; accepted formats: {', '.join(FORMATS)}")
-    return _load_with_progress(path, format, progress)
+    kw: dict[str, Any] = {}
+    if max_gap_s is not None:
+        if format not in ("table", "nmea"):
+            raise ValueError(f"max_gap_s applies to the formats table and nmea, not {format!r}")
+        kw["max_gap_s"] = max_gap_s
+    if columns is not None:
+        kw["columns"] = columns
+    return _load_with_progress(path, format, progress, **kw)
 
 
 _SOURCE_GLOBS: tuple[tuple[str, str], ...] = (

@@ -159,6 +159,27 @@ def _check_excitation(runs: Sequence[Record]) -> None:
     )
 
 
+def _split_segments(
+    runs: list[Record], multi_run: bool, say: Callable[[str], None]
+) -> list[Record]:
+    """Records split at their gaps (``meta["segments"]``): every segment a run for a family
+    that takes several runs, else the longest segment (said)."""
+    out: list[Record] = []
+    for rec in runs:
+        parts = rec.segments()
+        if len(parts) == 1 or multi_run:
+            out += parts
+            continue
+        longest = max(parts, key=lambda p: p.duration)
+        say(
+            f"{rec.meta.get('file') or 'record'} has {len(parts)} segments between gaps; this "
+            f"model is fitted to one stretch: the longest, {longest.time[0]:g}-"
+            f"{longest.time[-1]:g} s ({longest.n} samples)"
+        )
+        out.append(longest)
+    return out
+
+
 def identify(
     record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
@@ -216,6 +237,8 @@ def identify(
             )
     if not runs:
         raise ValueError("identify needs at least one record")
+    say = progress or (lambda _msg: None)
+    runs = _split_segments(runs, family.multi_run, say)
     if len(runs) > 1 and not family.multi_run:
         raise ValueError(
             f"model {family.name!r} is fitted to one record at a time, got {len(runs)}; the "
@@ -234,7 +257,6 @@ def identify(
         raise ValueError(f"max_effects must be an integer >= 0, got {max_effects!r}")
     _check_excitation(runs)
     window = family.resolve_window(window_s, max(float(r.time[-1] - r.time[0]) for r in runs))
-    say = progress or (lambda _msg: None)
     ctx = family.prepare(runs if family.multi_run else runs[0], float(holdout), window)
     window = getattr(ctx, "window_s", window)  # a family may resolve "auto" from the record
 
