@@ -72,6 +72,7 @@ Plots are written with :class:`matplotlib.figure.Figure` and the Agg canvas (no 
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -83,6 +84,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
 from shipgym.models import MODEL_NAMES, ShipModel, SimulationResult, make_model
+from shipgym.models.model_file import is_model_file, model_info
 
 __all__ = [
     "PARTICULARS",
@@ -116,7 +118,7 @@ __all__ = [
 ]
 
 SIDES = ("starboard", "port")
-ModelLike = str | ShipModel
+ModelLike = str | os.PathLike[str] | ShipModel
 Progress = Callable[[str], None] | None
 
 _BLUE, _ORANGE, _GREEN, _RED, _GREY, _PURPLE = (
@@ -241,21 +243,46 @@ _RIGS: dict[str, _RigSettings] = {
 }
 
 
+def _identified_particulars(ship: ShipModel, info: dict[str, Any]) -> ShipParticulars | None:
+    """The particulars of an identified Nomoto-family ship (None for the 3-DOF families, whose
+    parameters carry their own): its length from the model file (NaN when the record did not
+    state it: the ratios to L are then not computed), a beam of L / 6 for the plots, and the
+    service speed of its surge model."""
+    if ship.surge is None:
+        return None
+    length = info.get("length_m")
+    L = float(length) if length else math.nan
+    source = info.get("source") or "a record"
+    return ShipParticulars(
+        f"ship identified from {source} ({info.get('model', ship.name)})",
+        L,
+        L / 6.0,
+        ship.surge.service_speed,
+    )
+
+
 class _Rig:
     """One model set up for the trials: approach state, rudder mapping, speed, settings."""
 
     def __init__(self, model: ModelLike, dt: float | None) -> None:
+        identified: ShipParticulars | None = None
         if isinstance(model, ShipModel):
             ship = model
+        elif is_model_file(model):
+            ship = make_model(model)
+            identified = _identified_particulars(ship, model_info(model))
         elif isinstance(model, str):
             ship = make_model(model)  # raises ValueError for an unknown name
         else:
             raise ValueError(
-                f"model must be a model name {MODEL_NAMES} or a ShipModel, got {model!r}"
+                f"model must be a model name {MODEL_NAMES}, a model file FIT.json or a "
+                f"ShipModel, got {model!r}"
             )
         self.ship = ship
         self.name = ship.name
-        if ship.name == "kvlcc2":
+        if identified is not None:
+            self.particulars = identified
+        elif ship.name == "kvlcc2":
             p = ship.params
             vessel = f"KVLCC2 ({p.length:g} m)" if p.length != _KVLCC2.length else _KVLCC2.vessel
             self.particulars = ShipParticulars(vessel, p.length, p.breadth, p.approach_speed)

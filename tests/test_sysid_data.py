@@ -129,7 +129,7 @@ def test_load_all_returns_every_file() -> None:
         warnings.simplefilter("always")
         recs = load_all(MEASURED)
     assert len(recs) == len(FILES)
-    assert {r.meta["source"] for r in recs} == set(FORMATS) - {"canonical"}
+    assert {r.meta["source"] for r in recs} == set(FORMATS) - {"canonical", "table", "nmea"}
     assert all(issubclass(w.category, SysidDataWarning) for w in caught)
 
 
@@ -705,11 +705,15 @@ def test_wrapped_canonical_psi_unwrapped(tmp_path: Path) -> None:
 # ---------------------------------------------------------------------------------------------
 def test_unknown_format_lists_accepted(tmp_path: Path) -> None:
     path = tmp_path / "mystery.txt"
-    path.write_text("a,b,c\n1,2,3\n")
+    path.write_text("hello\n")
     with pytest.raises(ValueError, match="accepted formats: sspa, marin, hsva"):
         load(path)
     with pytest.raises(ValueError, match=r"unknown format 'xyz'.*gunnerus"):
         load(path, format="xyz")
+    # a table of unknown columns is a ship's own table: the column map is asked for
+    path.write_text("a,b,c\n1,2,3\n2,3,4\n")
+    with pytest.raises(ValueError, match=r"cannot map the columns \['a', 'b', 'c'\].*--columns"):
+        load(path)
 
 
 def test_wrong_explicit_format_names_expected_header(tmp_path: Path) -> None:

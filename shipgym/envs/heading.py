@@ -88,7 +88,10 @@ class NomotoHeadingEnv(ShipEnv):
 
     @property
     def ship_dimensions(self) -> tuple[float, float]:
-        return (NomotoHeadingTask.ship_length, NomotoHeadingTask.ship_beam)
+        return (
+            self.task.ship_length,
+            NomotoHeadingTask.ship_beam * self.task.ship_length / NomotoHeadingTask.ship_length,
+        )
 
     def _draw_args(self, i: int) -> dict[str, Any]:
         return {"setpoint_heading": float(self.task.metrics(i)["heading_setpoint"])}

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -46,6 +47,8 @@ from shipgym.envs import kernels
 from shipgym.envs.streams import RowStreams
 from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
 from shipgym.models.angles import ssa
+from shipgym.models.delay import DelayLine
+from shipgym.models.model_file import is_model_file, load_model, model_info
 from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
 
 COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
@@ -188,6 +191,12 @@ class Task:
         self.u0 = np.zeros(model.nu)
         self.B = np.zeros((model.nu, self.act_dim))
         self._step_args: tuple[Any, ...] | None = None
+        #: The rudder command's transport delay of an identified ship (None: no delay).
+        self.delay = (
+            DelayLine(model.input_delay, self.dt, self.n, self.act_dim)
+            if model.input_delay
+            else None
+        )
         bounds = np.array(self.obs_bounds, dtype=np.float64)
         self.obs_low, self.obs_high = bounds[:, 0].copy(), bounds[:, 1].copy()
 
@@ -296,6 +305,9 @@ class Task:
         """Step every row with the actions in ``self.a``; returns a bad action row or -1."""
         if self._step_args is None:  # built once: every array is updated in place
             self._step_args = self._args(True, np.arange(self.n))
+        if self.delay is not None and np.isfinite(self.a).all():  # (a bad action steps no row)
+            np.clip(self.a, -1.0, 1.0, out=self.a)
+            self.a[:] = self.delay.push(self.a)
         return self._kernel(self.n)(*self._step_args)
 
     def reset_rows(
@@ -347,6 +359,8 @@ class Task:
         self.x[rows] = states
         self.steps[rows] = 0
         self.a[rows] = 0.0
+        if self.delay is not None:
+            self.delay.reset(rows)
         self._reset_task(rows, task_draws, options)
         self._kernel(rows.size)(*self._args(False, rows))
 
@@ -552,13 +566,16 @@ class NomotoHeadingTask(HeadingTask):
     def __init__(
         self,
         n: int,
-        model: str = "nomoto1",
+        model: str | os.PathLike[str] | ShipModel = "nomoto1",
         max_current_speed: float = 1.0,
         setpoint_interval: float = 200.0,
     ) -> None:
-        if model not in NOMOTO_MODEL_NAMES:
-            raise ValueError(f"unknown model {model!r}; expected one of {NOMOTO_MODEL_NAMES}")
-        super().__init__(n, make_model(model), max_current_speed, setpoint_interval)
+        ship = nomoto_ship(model)
+        if isinstance(model, str | os.PathLike) and is_model_file(model):
+            length = model_info(model).get("length_m")
+            # an identified ship of unknown length: a small craft's, so the ranges are wide
+            self.ship_length = float(length) if length else IDENTIFIED_SHIP_LENGTH
+        super().__init__(n, ship, max_current_speed, setpoint_interval)
         gear, surge = self.model.gear, self.model.surge
         assert gear is not None and surge is not None
         self.u0[:] = (0.0, surge.service_shaft_speed)
@@ -582,6 +599,33 @@ class NomotoHeadingTask(HeadingTask):
         x[:, self.ipsi] = _uniform(draws[:, 0], -math.pi, math.pi)
         x[:, self.model.index("U")] = self.service_speed
         return x
+
+
+IDENTIFIED_SHIP_LENGTH = 10.0
+"""Length [m] taken for an identified ship whose model file states none (for the ranges of the
+reset options: a short ship allows fast turns)."""
+
+
+def nomoto_ship(model: Any) -> ShipModel:
+    """The Nomoto-family ship of ``shipgym/NomotoHeading-v0``: a model name, a model file
+    (``shipgym identify --json``) or a :class:`ShipModel` of the family."""
+    if isinstance(model, ShipModel):
+        ship = model
+    elif isinstance(model, str | os.PathLike) and is_model_file(model):
+        ship = load_model(model)
+    elif isinstance(model, str) and model in NOMOTO_MODEL_NAMES:
+        return make_model(model)
+    else:
+        raise ValueError(
+            f"unknown model {model!r}; expected one of {NOMOTO_MODEL_NAMES}, a model file "
+            "FIT.json (shipgym identify --json) or a ShipModel of the Nomoto family"
+        )
+    if ship.name not in NOMOTO_MODEL_NAMES:
+        raise ValueError(
+            f"model {ship.name!r} ({model!r}) is not of the Nomoto family {NOMOTO_MODEL_NAMES} "
+            "that this env steers (a 3-DOF fit runs in shipgym simulate)"
+        )
+    return ship
 
 
 class RVGMixin:

@@ -33,6 +33,7 @@ from shipgym.models._checks import (
     step_size,
 )
 from shipgym.models.current import Current
+from shipgym.models.delay import DelayLine
 from shipgym.models.mmg import MMG_INPUTS, MMG_STATES, MMGParams, pack_mmg
 from shipgym.models.nomoto import (
     FIRST_ORDER_STATES,
@@ -112,6 +113,11 @@ class ShipModel:
         The model's parameter dataclass (yaw parameters for the Nomoto family).
     gear, surge : SteeringGear, SurgeModel or None
         Actuator and speed models of the Nomoto family (``None`` for the 3-DOF models).
+    input_delay : float
+        Transport delay [s] of the rudder command (Nomoto family; 0 for the others), an
+        identified effect: :meth:`simulate` and the envs apply it
+        (:class:`~shipgym.models.delay.DelayLine`); :meth:`step`, :meth:`deriv` and
+        :meth:`linearize` are the delay-free dynamics.
 
     Checks
     ------
@@ -139,6 +145,7 @@ class ShipModel:
     params: Any
     gear: SteeringGear | None = None
     surge: SurgeModel | None = None
+    input_delay: float = 0.0
     model_id: int = field(init=False)
     p: np.ndarray = field(init=False, repr=False)
     state_names: tuple[str, ...] = field(init=False)
@@ -166,6 +173,20 @@ class ShipModel:
             second = self.name in ("nomoto2", "bech")
             set_(self, "state_names", SECOND_ORDER_STATES if second else FIRST_ORDER_STATES)
             set_(self, "input_names", NOMOTO_INPUTS)
+        delay = self.input_delay
+        if not (
+            isinstance(delay, int | float)
+            and not isinstance(delay, bool)
+            and math.isfinite(delay)
+            and delay >= 0.0
+        ):
+            raise ValueError(f"input_delay must be a finite time >= 0 s, got {delay!r}")
+        if delay and self.name not in NOMOTO_MODEL_NAMES:
+            raise ValueError(
+                f"input_delay applies to the rudder command of the Nomoto family "
+                f"{NOMOTO_MODEL_NAMES}, not to model {self.name!r}"
+            )
+        set_(self, "input_delay", float(delay))
         set_(self, "model_id", integrate.MODEL_IDS[self.name])
         integrate.check_parameters(self.model_id, self.p)
         self.p.flags.writeable = False
@@ -492,7 +513,10 @@ class ShipModel:
         inputs : array_like or callable
             Either an ``(n_steps, nu)`` array of inputs held over each step, or a function
             ``(t, x) -> u`` called at the start of each step (a controller in the loop) that
-            returns a finite input of shape ``(nu,)``.
+            returns a finite input of shape ``(nu,)``. With an :attr:`input_delay` these are
+            the commands; the rudder command reaches the ship late
+            (:class:`~shipgym.models.delay.DelayLine`), and the result's ``inputs`` are the
+            commands.
         dt : float
             Step [s]: finite, > 0 and within the model's stable step at rest
             (:meth:`stable_step`).
@@ -548,6 +572,7 @@ class ShipModel:
         if not math.isfinite(time[-1]):
             raise ValueError(f"dt * n_steps must be a finite time, got {dt!r} s * {n_steps}")
         u = np.empty((1, self.nu))
+        delay = DelayLine(self.input_delay, dt, 1, 1) if self.input_delay else None
         for k in range(n_steps):
             if policy is not None:
                 if k > 0 and not np.isfinite(x).all():
@@ -556,6 +581,8 @@ class ShipModel:
                     )
                 u_seq[k] = self._policy_input(policy(time[k], x[0].copy()), time[k])
             u[0] = u_seq[k]
+            if delay is not None:
+                u[0, 0] = delay.push(u[:, :1])[0, 0]
             integrate.rk4_step_kernel(self.model_id, x, u, self.p, c, dt)
             states[k + 1] = x[0]
         if not np.isfinite(states).all():
@@ -586,14 +613,17 @@ def make_model(
     params: Any | None = None,
     gear: SteeringGear | None = None,
     surge: SurgeModel | None = None,
+    input_delay: float = 0.0,
 ) -> ShipModel:
     """Build a model by name with default (documented) or given parameters.
 
     Parameters
     ----------
-    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2", "vmm"}
+    name : {"nomoto1", "nomoto2", "norrbin", "bech", "rvg3dof", "kvlcc2", "vmm"} or path
         Model name (``kvlcc2``: the MMG standard model, :mod:`shipgym.models.mmg`; ``vmm``:
-        seed 003's general model, :mod:`shipgym.models.vmm`).
+        seed 003's general model, :mod:`shipgym.models.vmm`), or the path of a model file
+        ending in ``.json`` (``shipgym identify --json``; :func:`shipgym.models.model_file.
+        load_model`), which takes no further arguments.
     params : dataclass or str, optional
         Parameters of the right type (e.g. :class:`Nomoto1Params`, :class:`MMGParams`);
         defaults otherwise. For ``rvg3dof`` also the name of a shipped set (``"seed001"``,
@@ -601,6 +631,8 @@ def make_model(
         :class:`VMMParams` or the path of a fitted model's JSON (:meth:`VMMParams.load`).
     gear, surge : SteeringGear, SurgeModel, optional
         Steering gear and surge model of the Nomoto family.
+    input_delay : float
+        Transport delay [s] of the rudder command (Nomoto family).
 
     Returns
     -------
@@ -614,10 +646,18 @@ def make_model(
     ValueError
         For an unknown name or parameters of the wrong type.
     """
+    from shipgym.models.model_file import is_model_file, load_model
+
+    if is_model_file(name):
+        if params is not None or gear is not None or surge is not None or input_delay:
+            raise ValueError(f"a model file ({str(name)!r}) takes no further model arguments")
+        return load_model(name)
     if not isinstance(name, str):
         raise TypeError(f"model name must be a str, one of {MODEL_NAMES}, got {short_repr(name)}")
     if name not in MODEL_NAMES:
-        raise ValueError(f"unknown model {name!r}; expected one of {MODEL_NAMES}")
+        raise ValueError(
+            f"unknown model {name!r}; expected one of {MODEL_NAMES} or a model file FIT.json"
+        )
     _check_actuators(gear, surge, required=False)
     if name == "vmm":
         if isinstance(params, str | os.PathLike):
@@ -642,5 +682,7 @@ def make_model(
     elif not isinstance(params, expected):
         raise ValueError(f"model {name!r} takes {expected.__name__}, got {type(params).__name__}")
     if name in three_dof:
+        if input_delay:
+            raise ValueError(f"input_delay applies to the Nomoto family, not to {name!r}")
         return ShipModel(name, params)
-    return ShipModel(name, params, gear or SteeringGear(), surge or SurgeModel())
+    return ShipModel(name, params, gear or SteeringGear(), surge or SurgeModel(), input_delay)

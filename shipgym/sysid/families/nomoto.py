@@ -108,6 +108,7 @@ from scipy.signal import savgol_filter
 from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
 from shipgym.models._jit import kernel
 from shipgym.models.integrate import NOMOTO1, rk4_block
+from shipgym.models.model_file import nomoto_document
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
@@ -1148,6 +1149,7 @@ class NomotoFamily(ModelFamily):
             "error_after": errors(rec, sim_after),
             "heldout": heldout,
             "traces": _traces(rec, ctx.split, starts, sim_before, sim_after),
+            "model_file": {"nomoto": _model_document(full, rec)},
             # the input filters' constants of the whole-record fit
             "effect_parameters": {
                 e: self.effect_parameters(full, e)
@@ -1155,6 +1157,25 @@ class NomotoFamily(ModelFamily):
                 if e in ("rudder_lag", "input_delay")
             },
         }
+
+
+def _model_document(full: _Fitted, rec: Record) -> dict[str, Any]:
+    """The final model as a model file entry (:func:`shipgym.models.model_file.
+    nomoto_document`): every yaw effect, the lag and the delay are part of it."""
+    cfg = full.config
+    speed = _record_speed(rec)
+    length = rec.meta.get("L")
+    return nomoto_document(
+        cfg.model,
+        {f.name: getattr(full.fit.params, f.name) for f in fields(full.fit.params)},
+        rudder_offset=full.fit.delta0,
+        rudder_lag=full.T_d if cfg.lag else None,
+        input_delay=full.tau if cfg.delay else 0.0,
+        speed=None if speed is None else float(np.median(speed)),
+        length=float(length) if isinstance(length, int | float) else None,
+        current=full.drift,
+        source=str(rec.meta.get("file") or rec.meta.get("source") or ""),
+    )
 
 
 def _heldout_errors(cand: Candidate) -> dict[str, float]:
