@@ -562,7 +562,12 @@ def load_table(
         meta["conversions"].append(text)
     names = {ch: col for ch, (col, _, _) in mapping.items()}
     return record_from_arrays(
-        arrays, units=units, meta=meta, max_gap_s=max_gap_s, names=names, first_row=rows[1][0]
+        arrays,
+        units=units,
+        meta=meta,
+        max_gap_s=max_gap_s,
+        names=names,
+        line_numbers=[ln for ln, _ in rows[1:]],
     )
 
 
@@ -576,7 +581,7 @@ def record_from_arrays(
     meta: Mapping[str, Any] | None = None,
     max_gap_s: float | None = None,
     names: Mapping[str, str] | None = None,
-    first_row: int = 0,
+    line_numbers: Sequence[int] | None = None,
 ) -> Record:
     """A :class:`Record` from channel arrays in any units (:meth:`Record.from_arrays`).
 
@@ -594,8 +599,8 @@ def record_from_arrays(
         Longest time step [s] inside a segment (default :data:`GAP_FACTOR` median steps).
     names : mapping, optional
         Channel -> the source's column name, for the messages.
-    first_row : int
-        Line number of the first sample (for the messages of text files).
+    line_numbers : sequence of int, optional
+        The text line of each sample (for the messages of text files).
     """
     units = dict(units or {})
     out_meta: dict[str, Any] = {"source": "arrays", "conversions": [], "repairs": [], "notes": []}
@@ -660,7 +665,7 @@ def record_from_arrays(
     if np.any(np.isfinite(t_all[1:]) & np.isfinite(t_all[:-1]) & (np.diff(t_all) < 0)):
         i = int(np.flatnonzero(np.diff(t_all) < 0)[0])
         col = (names or {}).get("time", "time")
-        row = f" (line {first_row + i + 1})" if first_row else f" (sample {i + 1})"
+        row = f" (line {line_numbers[i + 1]})" if line_numbers else f" (sample {i + 1})"
         raise ValueError(
             f"{where}: time goes backwards at {t_all[i]:g} -> {t_all[i + 1]:g} s in column "
             f"{col!r}{row}; expected increasing time"
