@@ -19,6 +19,7 @@ from scipy.integrate import solve_ivp
 from shipgym import maneuvers as mv
 from shipgym.cli import main
 from shipgym.models import NorrbinParams, SteeringGear, make_model
+from shipgym.sysid.data import measured_root
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 N3 = NorrbinParams().n3
@@ -457,10 +458,13 @@ def test_trial_quantities_refuse_series_without_a_trial() -> None:
         mv.zigzag_quantities(t, t, t, -1.0)
 
 
-SIMMAN = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
+SIMMAN = measured_root()
 
 
-@pytest.mark.skipif(not (SIMMAN / "marin_kvlcc2").is_dir(), reason="SIMMAN records not found")
+@pytest.mark.skipif(
+    not (SIMMAN / "marin_kvlcc2").is_dir(),
+    reason="SIMMAN records not found (set SHIPGYM_MEASURED_DATA)",
+)
 def test_published_kvlcc2_turns_like_marin_and_under_predicts_its_overshoots() -> None:
     """The MMG KVLCC2 with the published coefficients (full scale) against MARIN's SIMMAN 2008
     free-running tests: its 35 deg advance and tactical diameter are within 8 % of the

@@ -17,11 +17,13 @@ from shipgym.sysid.data import (
     detect_format,
     load,
     load_all,
+    measured_root,
 )
 
-MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+MEASURED = measured_root()
 needs_data = pytest.mark.skipif(
-    not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}"
+    not MEASURED.is_dir(),
+    reason=f"measured data not found at {MEASURED} (set SHIPGYM_MEASURED_DATA)",
 )
 
 EXPECTED_FORMAT = {

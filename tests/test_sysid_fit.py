@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +14,7 @@ from shipgym.models import (
     NorrbinParams,
     make_model,
 )
+from shipgym.sysid.data import measured_root
 from shipgym.sysid.fit import (
     FitResult,
     fit_equation_error,
@@ -29,7 +29,7 @@ from shipgym.sysid.recursive import (
     run_rls,
 )
 
-MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+MEASURED = measured_root()
 
 
 def record(name, params, n, dt, *, sub=10, r0=0.0, seed=0, sr=0.0, sp=0.0, hold=60.0, zigzag=False):
@@ -165,7 +165,7 @@ def test_replay_reproduces_model_simulation():
 def test_sspa_zigzag_first_order():
     path = MEASURED / "sspa_blog_zigzag" / "example_zigzag.csv"
     if not path.exists():
-        pytest.skip(f"measured data not found at {path}")
+        pytest.skip(f"measured data not found at {path} (set SHIPGYM_MEASURED_DATA)")
     data = np.genfromtxt(path, delimiter=";", names=True)
     t, delta, psi, r = data["time"], -data["delta"], data["psi"], data["r"]
     delta = delta - delta[0]

@@ -16,12 +16,13 @@ import pytest
 import shipgym.sysid.data as data_module
 from shipgym.cli import main
 from shipgym.sysid import identify
-from shipgym.sysid.data import Record, SysidDataWarning, load
+from shipgym.sysid.data import Record, SysidDataWarning, load, measured_root
 from shipgym.sysid.fit import fit_equation_error, fit_output_error
 
-MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+MEASURED = measured_root()
 needs_data = pytest.mark.skipif(
-    not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}"
+    not MEASURED.is_dir(),
+    reason=f"measured data not found at {MEASURED} (set SHIPGYM_MEASURED_DATA)",
 )
 
 

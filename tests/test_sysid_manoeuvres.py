@@ -10,14 +10,16 @@ import numpy as np
 import pytest
 
 from shipgym.sysid import manoeuvres as mv
-from shipgym.sysid.data import Record, SysidDataWarning, load
+from shipgym.sysid.data import Record, SysidDataWarning, load, measured_root
 
 # one worker runs this file: its module fixtures are built once (pytest-xdist)
 pytestmark = pytest.mark.xdist_group("test_sysid_manoeuvres")
 
-MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+MEASURED = measured_root()
 GUNNERUS = MEASURED / "gunnerus_seatrials" / "RVG_ManeuveringTests.csv"
-needs_data = pytest.mark.skipif(not GUNNERUS.is_file(), reason=f"measured data not at {GUNNERUS}")
+needs_data = pytest.mark.skipif(
+    not GUNNERUS.is_file(), reason=f"measured data not at {GUNNERUS} (set SHIPGYM_MEASURED_DATA)"
+)
 
 DEG = math.pi / 180.0
 
@@ -317,7 +319,7 @@ def test_table_errors_of_a_faster_lookup_model(trials) -> None:
 @pytest.mark.parametrize("k", [2, 3])
 def test_folds_partition_the_manoeuvres_and_mask_their_spans(request, source, k) -> None:
     if source == "trials" and not GUNNERUS.is_file():
-        pytest.skip(f"measured data not at {GUNNERUS}")
+        pytest.skip(f"measured data not at {GUNNERUS} (set SHIPGYM_MEASURED_DATA)")
     rec, ms = request.getfixturevalue("synth" if source == "synthetic" else "trials")
     out = mv.folds(ms, k)
     assert len(out) == k

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from shipgym.sysid import report
-from shipgym.sysid.data import Record, load
+from shipgym.sysid.data import Record, load, measured_root
 from shipgym.sysid.generator import generate_record
 from shipgym.sysid.report import (
     benchmark_sysid,
@@ -422,10 +422,13 @@ def test_benchmark_sysid_smoke() -> None:
     json.dumps(rep)
 
 
-MEASURED = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "measured"
+MEASURED = measured_root()
 
 
-@pytest.mark.skipif(not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}")
+@pytest.mark.skipif(
+    not MEASURED.is_dir(),
+    reason=f"measured data not found at {MEASURED} (set SHIPGYM_MEASURED_DATA)",
+)
 def test_identify_all_reads_the_measured_root() -> None:
     rows = identify_all(MEASURED, only="esso_osaka/zigzag_31-Jul-2020_13_57", max_effects=0)
     # nomoto1 on every record, the 3-DOF model on a ship whose particulars are known

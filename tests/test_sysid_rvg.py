@@ -182,16 +182,13 @@ def test_sea_trials_loop_names_the_pod_lift_first() -> None:
     """On the real Gunnerus trials the loop from the seed-001 base names the pod normal force
     first, with a coefficient within a factor 2 of the Kongsberg pod data, and cuts the held-out
     heading error at least fourfold against the calibrated base."""
-    from pathlib import Path
 
     from shipgym.sysid import load
+    from shipgym.sysid.data import measured_root
 
-    path = (
-        Path(__file__).resolve().parents[2]
-        / "shared/data/measured/gunnerus_seatrials/RVG_ManeuveringTests.csv"
-    )
+    path = measured_root() / "gunnerus_seatrials/RVG_ManeuveringTests.csv"
     if not path.exists():
-        pytest.skip(f"measured record not found: {path}")
+        pytest.skip(f"measured record not found: {path} (set SHIPGYM_MEASURED_DATA)")
     res = identify(load(path), "rvg3dof", max_effects=1)
     assert res.effect_names == ["thruster_lift"]
     c_l = res.effects[0]["parameters"]["pod_lift_coefficient"]
@@ -241,19 +238,16 @@ def test_the_days_current_explains_the_opposite_heading_straight_speeds() -> Non
     eastward, and predicting the straights in it cuts their RMS speed error by at least a fifth
     (the two 110 rpm runs heading east and north-east stay 3-6 % slow: the current is not
     constant over 2.5 h of tide)."""
-    from pathlib import Path
 
     from shipgym.sysid import load
     from shipgym.sysid import manoeuvres as mn
+    from shipgym.sysid.data import measured_root
     from shipgym.sysid.families.base import window_starts
     from shipgym.sysid.families.rvg import RVG_WINDOW_S, fit_rvg, simulate_orders
 
-    path = (
-        Path(__file__).resolve().parents[2]
-        / "shared/data/measured/gunnerus_seatrials/RVG_ManeuveringTests.csv"
-    )
+    path = measured_root() / "gunnerus_seatrials/RVG_ManeuveringTests.csv"
     if not path.exists():
-        pytest.skip(f"measured record not found: {path}")
+        pytest.skip(f"measured record not found: {path} (set SHIPGYM_MEASURED_DATA)")
     rec = load(path)
     starts = window_starts(rec.time, RVG_WINDOW_S)
     mask = np.ones(rec.time.size, dtype=bool)

@@ -23,7 +23,7 @@ from shipgym.models import Nomoto1Params, Nomoto2Params, make_model
 from shipgym.models.delay import DelayLine
 from shipgym.models.model_file import load_model, nomoto_document
 from shipgym.sysid import Record, generate_record, identify, load
-from shipgym.sysid.data import SysidDataWarning
+from shipgym.sysid.data import SysidDataWarning, measured_root
 from shipgym.sysid.table import parse_columns
 
 pytestmark = pytest.mark.xdist_group("test_user_logs")
@@ -392,3 +392,20 @@ def test_model_files_in_simulate_and_their_errors(
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert make_model(str(path)).name == "nomoto1"
+
+
+USV = measured_root() / "usv_field" / "zigzag_30_inter_xy.csv"
+
+
+@pytest.mark.skipif(not USV.is_file(), reason=f"{USV} not found (set SHIPGYM_MEASURED_DATA)")
+def test_the_usv_field_record_through_a_column_map_is_the_usv_loaders_record() -> None:
+    """The field USV's zigzag read as anyone's table (degrees, knots, lat/lon) gives the record
+    of the project's own USV loader, which was checked against the source's documentation."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SysidDataWarning)
+        mine = load(
+            USV, columns="time=time,delta=rudder:deg,psi=heading:deg,U=speed:kn,lat=lat,lon=lon"
+        )
+        ref = load(USV, "usv")
+    for name in ("time", "delta", "psi", "r", "x", "y", "U"):
+        np.testing.assert_allclose(getattr(mine, name), getattr(ref, name), rtol=1e-12, atol=1e-9)

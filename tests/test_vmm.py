@@ -24,13 +24,14 @@ from shipgym.models.vmm import (
     term_matrix,
 )
 from shipgym.sysid import identify, load
+from shipgym.sysid.data import measured_root
 from shipgym.sysid.families.vmm import prepare_runs, regress, vessel_params
 from shipgym.sysid.generator import generate_vmm_runs, vmm_truth
 
 # one worker runs this file: its module fixtures are built once (pytest-xdist)
 pytestmark = pytest.mark.xdist_group("test_vmm")
 
-MEASURED = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
+MEASURED = measured_root()
 HSVA = sorted((MEASURED / "hsva_kvlcc2").glob("*.dat"))
 
 
@@ -259,7 +260,9 @@ def test_a_record_of_an_unknown_ship_asks_for_particulars() -> None:
 # the measured KVLCC2
 
 
-@pytest.mark.skipif(not HSVA, reason="measured HSVA records not present")
+@pytest.mark.skipif(
+    not HSVA, reason="measured HSVA records not present (set SHIPGYM_MEASURED_DATA)"
+)
 def test_hsva_inverse_dynamics_explain_the_side_force_and_moment() -> None:
     recs = [load(p) for p in HSVA]
     template = vessel_params(recs[0])
@@ -325,7 +328,9 @@ def test_identify_all_adds_a_3dof_row_for_records_of_a_known_ship() -> None:
     assert "X_T" in row["parameters_after"]
 
 
-@pytest.mark.skipif(not HSVA, reason="measured HSVA records not present")
+@pytest.mark.skipif(
+    not HSVA, reason="measured HSVA records not present (set SHIPGYM_MEASURED_DATA)"
+)
 def test_kvlcc2_mmg_derivatives_refined_on_hsva_runs() -> None:
     """The MMG model's resistance and linear hull derivatives, refined on HSVA runs by output
     error, stay inside their bounds, move the published yaw damping by many standard errors

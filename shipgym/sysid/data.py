@@ -139,6 +139,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import sys
 import time
@@ -163,6 +164,7 @@ __all__ = [
     "detect_format",
     "load",
     "load_all",
+    "measured_root",
     "wrap_angle",
 ]
 
@@ -1900,6 +1902,19 @@ def load(
     if columns is not None:
         kw["columns"] = columns
     return _load_with_progress(path, format, progress, **kw)
+
+
+MEASURED_DATA_ENV = "SHIPGYM_MEASURED_DATA"
+"""Environment variable naming the ``measured`` folder (a copy of ``../shared/data/measured``)."""
+
+
+def measured_root() -> Path:
+    """The measured-data folder: ``$SHIPGYM_MEASURED_DATA`` when set, else
+    ``../shared/data/measured`` beside the checkout (where the project's sources keep it)."""
+    env = os.environ.get(MEASURED_DATA_ENV)
+    if env:
+        return Path(env).expanduser()
+    return Path(__file__).resolve().parents[3] / "shared" / "data" / "measured"
 
 
 _SOURCE_GLOBS: tuple[tuple[str, str], ...] = (
