@@ -1,6 +1,6 @@
 """Synthetic manoeuvring records with one undeclared effect, for testing identification tools.
 
-Issue 4 section 5 asks for "the project's own generator of records with one undeclared effect":
+The known truth of identification tests:
 a record that looks like a measured one (:class:`shipgym.sysid.data.Record`, canonical units and
 sign convention) but whose ship deviates from a base model (:data:`BASE_MODELS`) in exactly one
 documented way. Every record is simulated through :mod:`shipgym.models`

@@ -1,9 +1,7 @@
 """Identification report over every measured record, and the speed benchmark of the loop.
 
-Issue 4 ("System identification that closes the loop with measured data"):
-
-* "Every measured dataset: a table in the README (or a linked doc) with error before and
-  after, the effects found and the parameters, produced by one script" -> :func:`identify_all`
+* Every measured record: a table of the simulation error before and after, the effects found
+  and the parameters, made by one script: :func:`identify_all`
   runs :func:`shipgym.sysid.engine.identify` on every record (``nomoto1``, seed 000
   ``T r' + r = K delta``, on all of them; also ``rvg3dof``, the R/V Gunnerus 3-DOF model of
   seed 001, on the records with pod channels, i.e. the Gunnerus sea trials);
@@ -14,10 +12,10 @@ Issue 4 ("System identification that closes the loop with measured data"):
   per-record figure (:func:`shipgym.sysid.plots.plot_identification`), and
   :func:`update_readme` replaces the README block between ``<!-- identification -->`` markers.
   The script is ``scripts/identify_all.py``.
-* "Speed (benchmark, not tests): a first-order output-error fit of 10 000 samples under 1 s; the
-  whole loop on a 10 000-sample record under 10 s; the Gunnerus record under 60 s" ->
-  :func:`benchmark_sysid`, :func:`format_benchmark` and :func:`plot_benchmark`
-  (``scripts/bench_sysid.py``). Nothing here asserts a time.
+* The speed of the loop (a first-order output-error fit of 10 000 samples, the whole loop on a
+  10 000-sample record, the Gunnerus record), measured by :func:`benchmark_sysid` and shown by
+  :func:`format_benchmark` and :func:`plot_benchmark` (``scripts/bench_sysid.py``). Nothing
+  here asserts a time.
 
 Preparation of a record (:func:`prepare_record`): when the loader marked the manoeuvre inside a
 longer run (``meta["manoeuvre_start_s"]``/``meta["manoeuvre_end_s"]``: the Esso Osaka zigzag and

@@ -1,6 +1,6 @@
 """The Nomoto family: trace the residual of a yaw fit to one effect of a catalogue.
 
-Issue 4 section 3. The bases are the Nomoto-family yaw models of :mod:`shipgym.models`:
+The bases are the Nomoto-family yaw models of :mod:`shipgym.models`:
 ``nomoto1`` (seed 000, ``T r' + r = K delta``), ``nomoto2`` (seed 004 eq. 1), ``norrbin``
 (seed 002 eq. 1) and ``bech`` (seed 004 eq. 3), one :class:`NomotoFamily` each. The engine
 (:func:`shipgym.sysid.engine.identify`) runs the loop; this family
