@@ -1759,7 +1759,9 @@ def detect_format(path: str | Path) -> str:
         return by_folder[parent]
     if path.parent.parent.name.lower() == "esso_osaka_frt":
         return "esso_osaka"
-    if _NMEA_SENTENCE.search(first):
+    from shipgym.sysid.nmea import looks_like_nmea
+
+    if looks_like_nmea(head):
         return "nmea"
     if _looks_like_table(head):
         return "table"
@@ -1768,10 +1770,6 @@ def detect_format(path: str | Path) -> str:
         f"cannot detect the format of {path.name} ({reason}); accepted formats: "
         f"{', '.join(FORMATS)} (pass format=...)"
     )
-
-
-#: An NMEA 0183 sentence (``$HEHDT,...``, ``!AIVDM,...``), possibly after a logger's time stamp.
-_NMEA_SENTENCE = re.compile(r"[$!][A-Z][A-Z0-9]{4},")
 
 
 def _looks_like_table(head: str) -> bool:
