@@ -47,6 +47,12 @@ so the closed-loop poles are exactly ``-zeta w_n +- j w_n sqrt(1 - zeta^2)`` and
 integrator added: the dominant poles then move slightly). Both hold for any signs of ``K`` and
 ``T``; :meth:`HeadingAutopilot.design_report` checks the resulting loop with python-control.
 
+Margins with a rudder transport delay ``tau`` (:func:`loop_margins`): ``|e^{-j w tau}| = 1``, so
+the gain crossover ``w_c`` of ``L = C P`` stays where it is and the phase margin drops by
+``w_c tau``, ``PM_tau = PM_0 - w_c tau``; the delay margin is ``PM_tau / w_c`` (Åström and
+Murray, *Feedback Systems*, the phase margin and time delays). The phase crossovers move and
+are searched on the exact frequency response.
+
 Reference model (Fossen 2011, reference models for trajectory generation): a first-order
 low-pass in cascade with a
 mass-spring-damper,
@@ -98,8 +104,10 @@ __all__ = [
     "HeadingAutopilot",
     "HeadingDesignReport",
     "HeadingReferenceModel",
+    "LoopMargins",
     "default_bandwidth",
     "design_model",
+    "loop_margins",
     "pid_gains_nomoto",
 ]
 
@@ -274,6 +282,145 @@ def design_model(
             break
         w = w_new
     return float(K_e), float(T_e), float(w)
+
+
+@dataclass(frozen=True)
+class LoopMargins:
+    """Stability margins of an open loop ``L(s) e^{-s tau}`` (see :func:`loop_margins`).
+
+    Attributes
+    ----------
+    gain_margin_db : float
+        Gain margin [dB] at the phase crossover closest to instability (``inf`` when the
+        phase never crosses -180 deg; negative: a *lower* gain margin, as for an open-loop
+        unstable plant).
+    phase_margin_deg : float
+        Phase margin [deg] with the delay, the smallest over the gain crossovers (``inf``
+        when ``|L|`` never crosses 1).
+    gain_crossover : float
+        Frequency [rad/s] of that phase margin (``nan`` if none).
+    phase_crossover : float
+        Frequency [rad/s] of that gain margin (``nan`` if none).
+    delay_margin : float
+        Further input delay [s], on top of ``delay``, that brings a phase margin to zero:
+        the least ``PM_i / w_i`` over the gain crossovers (0 when a phase margin is
+        already negative, ``inf`` without a crossover).
+    delay : float
+        The input delay ``tau`` [s] in the loop.
+    """
+
+    gain_margin_db: float
+    phase_margin_deg: float
+    gain_crossover: float
+    phase_crossover: float
+    delay_margin: float
+    delay: float
+
+    def to_dict(self) -> dict[str, float | None]:
+        """JSON-ready values (non-finite numbers as ``None``)."""
+        return {
+            key: (value if math.isfinite(value) else None)
+            for key, value in (
+                ("gain_margin_db", self.gain_margin_db),
+                ("phase_margin_deg", self.phase_margin_deg),
+                ("gain_crossover_rad_s", self.gain_crossover),
+                ("phase_crossover_rad_s", self.phase_crossover),
+                ("delay_margin_s", self.delay_margin),
+                ("delay_s", self.delay),
+            )
+        }
+
+
+def _phase_crossovers(loop: control.TransferFunction, tau: float) -> np.ndarray:
+    """Every frequency [rad/s] where the phase of ``L(jw) e^{-jw tau}`` is -180 deg (mod
+    360), on a grid spanning the loop's poles and zeros, refined by Brent's method."""
+    from scipy.optimize import brentq
+
+    corners = np.abs(np.concatenate([control.poles(loop), control.zeros(loop)]))
+    corners = corners[corners > 0]
+    lo = 1e-3 * (corners.min() if corners.size else 1.0)
+    hi = 1e3 * (corners.max() if corners.size else 1.0)
+    hi = max(hi, 20.0 * math.pi / tau) if tau > 0 else hi
+    w = np.logspace(math.log10(lo), math.log10(hi), 8000)
+    phase = np.unwrap(np.angle(loop(1j * w))) - w * tau
+    turns = np.floor((phase + math.pi) / (2.0 * math.pi))
+    found = []
+    for i in np.nonzero(np.diff(turns) != 0)[0]:
+        target = (max(turns[i], turns[i + 1])) * 2.0 * math.pi - math.pi
+        p0, p1, w0, w1 = phase[i], phase[i + 1], w[i], w[i + 1]
+
+        def excess(x: float, p0: float = p0, p1: float = p1, w0: float = w0, w1: float = w1,
+                   target: float = target) -> float:  # fmt: skip
+            guess = p0 + (p1 - p0) * (x - w0) / (w1 - w0)
+            raw = float(np.angle(loop(1j * x))) - x * tau
+            return raw + 2.0 * math.pi * round((guess - raw) / (2.0 * math.pi)) - target
+
+        try:
+            found.append(brentq(excess, w0, w1, xtol=1e-12 * w1))
+        except ValueError:  # a jump of the wrapped phase, not a crossing
+            continue
+    return np.array(found)
+
+
+def loop_margins(loop: control.TransferFunction, delay: float = 0.0) -> LoopMargins:
+    """Gain, phase and delay margins of ``L(s) e^{-s tau}``, the delay taken exactly.
+
+    A pure delay has ``|e^{-j w tau}| = 1`` and phase ``-w tau``, so the gain crossovers
+    ``|L(j w_c)| = 1`` are those of ``L`` (python-control's :func:`control.stability_margins`)
+    and each phase margin is that of ``L`` less ``w_c tau``:
+
+    .. math:: PM_\\tau = PM_0 - \\omega_c \\tau, \\qquad
+              \\tau_{margin} = PM_\\tau / \\omega_c \\;[\\mathrm{rad} / (\\mathrm{rad/s})].
+
+    The phase crossovers move with the delay: without one they are python-control's; with
+    one, the frequencies where ``arg L(j w) - w tau = -180 deg (mod 360)`` are searched on a
+    logarithmic grid and refined (:func:`scipy.optimize.brentq`); the gain margin is
+    ``1 / |L|`` there, the crossover closest to 0 dB.
+
+    Parameters
+    ----------
+    loop : control.TransferFunction
+        The delay-free open loop ``L = C P`` (SISO).
+    delay : float
+        Input delay ``tau`` [s] >= 0.
+
+    Returns
+    -------
+    LoopMargins
+
+    Raises
+    ------
+    ValueError
+        For a loop that is not a SISO transfer function or a delay that is not a finite
+        number >= 0.
+    """
+    if not isinstance(loop, control.TransferFunction) or loop.ninputs != 1 or loop.noutputs != 1:
+        raise ValueError(f"loop must be a SISO control.TransferFunction, got {loop!r}")
+    tau = nonnegative("delay", delay)
+    gm, _pm, _sm, wpc, wgc, _wms = control.stability_margins(loop, returnall=True)
+    wgc = np.asarray(wgc, dtype=float)
+    if wgc.size:
+        lag = np.angle(loop(1j * wgc)) - wgc * tau  # rad
+        margins = np.mod(lag + 2.0 * math.pi, 2.0 * math.pi) - math.pi  # 180 + phase, wrapped
+        i = int(np.argmin(margins))
+        pm = math.degrees(float(margins[i]))
+        w_c = float(wgc[i])
+        delay_margin = float(np.min(np.maximum(margins, 0.0) / wgc))
+    else:
+        pm, w_c, delay_margin = math.inf, math.nan, math.inf
+    if tau > 0:
+        wpc = _phase_crossovers(loop, tau)
+        ratio = 1.0 / np.abs(loop(1j * wpc)) if wpc.size else np.empty(0)
+    else:
+        wpc, ratio = np.asarray(wpc, dtype=float), np.asarray(gm, dtype=float)
+    keep = np.isfinite(ratio) & (ratio > 0)
+    if np.any(keep):
+        db = 20.0 * np.log10(ratio[keep])
+        j = int(np.argmin(np.abs(db)))
+        gm_db, w_pc = float(db[j]), float(wpc[keep][j])
+    else:
+        gm_db, w_pc = math.inf, math.nan
+    return LoopMargins(gm_db, pm, w_c, w_pc, delay_margin, tau)
 
 
 @dataclass(frozen=True, eq=False)

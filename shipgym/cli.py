@@ -8,7 +8,7 @@ Subcommands::
     shipgym envs
     shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
     shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N]
-                     [--seed S] [--agents DIR] [--json OUT] [--plot DIR]
+                     [--seed S] [--agents DIR] [--gains FILE] [--json OUT] [--plot DIR]
                      [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
                   [--tensorboard DIR | --no-tensorboard] [--overwrite]
@@ -17,10 +17,11 @@ Subcommands::
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
                       [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]
                       [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N] [--no-throughput]
-    shipgym identify PATH [--format F] [--columns MAP] [--max-gap S]
+    shipgym identify PATH [--format F] [--columns MAP] [--max-gap S] [--length L]
                      [--model nomoto1|nomoto2|norrbin|bech|rvg3dof|vmm:...|kvlcc2]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
                      [--max-effects N] [--quiet]
+    shipgym design FILE.json [--json OUT] [--plot OUT.png] [--bandwidth W] [--damping Z]
 
 Each subcommand is registered by a builder in ``SUBCOMMANDS`` (name -> function that adds its
 parser and sets ``handler``). Bad input ends with a one-line message and exit code 2
@@ -423,6 +424,17 @@ _SIMULATE: dict[str, Callable[[argparse.Namespace], _Trial]] = {
 }
 
 
+def _model_name(text: str) -> str:
+    """``--model``: a model name or a model file ``*.json`` (read by the handler)."""
+    from shipgym.models import MODEL_NAMES
+
+    if text in MODEL_NAMES or text.lower().endswith(".json"):
+        return text
+    raise argparse.ArgumentTypeError(
+        f"must be one of {', '.join(MODEL_NAMES)} or a model file FIT.json, got {text!r}"
+    )
+
+
 def _run_simulate(args: argparse.Namespace) -> int:
     import json
 
@@ -439,9 +451,16 @@ def _run_simulate(args: argparse.Namespace) -> int:
     json_path = _output_path(args.json, "--json", ".json")
     plot_path = _output_path(args.plot, "--plot", ".png")
     from shipgym.models import make_model
+    from shipgym.models.model_file import is_model_file
     from shipgym.models.rvg import RVG_PARAMETER_SETS
 
-    if args.model == "vmm":
+    model_file = is_model_file(args.model)
+    if model_file:
+        if args.params is not None:
+            raise ValueError("--params does not go with a model file (the file is the model)")
+        args.ship = args.model
+        make_model(args.model)  # a bad model file fails here, before the trial starts
+    elif args.model == "vmm":
         if args.params is None:
             raise ValueError(
                 "--model vmm needs --params FIT.json: a fitted model (shipgym identify "
@@ -466,13 +485,21 @@ def _run_simulate(args: argparse.Namespace) -> int:
     if args.model == "rvg3dof":
         payload["params"] = args.ship.params.name
     if kind in ("zigzag", "turning"):
-        if args.model == "vmm":
+        if model_file:
+            lu = payload["length_m"] / payload["approach_speed_m_s"]
+        elif args.model == "vmm":
             lu = args.ship.params.length / args.ship.params.approach_speed
         else:
             lu = PARTICULARS[args.model].length_over_speed
-        title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
-        print(format_imo_table(rows, title=title))
-        payload["imo"] = [row.to_dict() for row in rows]
+        if math.isfinite(lu):
+            title = f"IMO MSC.137(76) criteria from this trial (L/U = {lu:.1f} s)"
+            print(format_imo_table(rows, title=title))
+            payload["imo"] = [row.to_dict() for row in rows]
+        else:
+            print(
+                f"IMO criteria not computed: {args.model} states no ship length (they are "
+                "ratios to L; set length_m in the file, or identify with --length L)"
+            )
     text = json.dumps(payload, indent=1, allow_nan=False) + "\n"
     outputs: list[tuple[Path, Callable[[Path], Any]]] = []
     if json_path is not None:
@@ -504,7 +531,12 @@ def _build_simulate(sub: Any) -> None:
     )
     p.add_argument("manoeuvre", choices=tuple(_SIMULATE), help="trial to run")
     p.add_argument(
-        "--model", default="nomoto1", choices=MODEL_NAMES, help="model (default: %(default)s)"
+        "--model",
+        default="nomoto1",
+        type=_model_name,
+        metavar="NAME|FIT.json",
+        help=f"model: one of {', '.join(MODEL_NAMES)} or an identified model file "
+        "(shipgym identify --json FIT.json); default %(default)s",
     )
     p.add_argument(
         "--params",
@@ -637,7 +669,18 @@ def _run_evaluate(args: argparse.Namespace) -> int:
     json_path = _output_path(args.json, "--json", ".json")
     plot_dir = None if args.plot is None else _output_dir(args.plot, "--plot")
     ray = _ray_options(args)
-    policy = make_policy(args.controller, args.env, args.agents)
+    if args.gains is not None:
+        from shipgym.benchmark.policies import GAINS_ENV
+
+        if args.controller != "classic" or args.env != GAINS_ENV:
+            raise ValueError(
+                f"--gains sets the classic heading autopilot of {GAINS_ENV}: use it with "
+                f"--env {GAINS_ENV} --controller classic, not --env {args.env} --controller "
+                f"{args.controller}"
+            )
+        if ray is not None:
+            raise ValueError("--gains runs the episodes here; drop --ray")
+    policy = make_policy(args.controller, args.env, args.agents, gains=args.gains)
     if hasattr(policy, "meta"):
         from shipgym.benchmark.runner import check_seeds_disjoint
 
@@ -735,6 +778,13 @@ def _build_evaluate(sub: Any) -> None:
         default=None,
         metavar="M_S",
         help="upper end of the drawn current speed [m/s] (default: the env's)",
+    )
+    p.add_argument(
+        "--gains",
+        default=None,
+        metavar="FILE",
+        help="gains of the classic NomotoHeading autopilot (shipgym design MODEL.json --json "
+        "FILE) instead of the design rule on the nominal ship",
     )
     p.add_argument("--json", default=None, metavar="OUT", help="write the summary as JSON")
     p.add_argument(
@@ -1609,6 +1659,8 @@ def _run_identify(args: argparse.Namespace) -> int:
             f"{record.dt:g} s; channels {chans})"
         )
         say(f"loaded {sources[-1]}")
+        if args.length is not None:
+            record.meta["L"] = args.length
         records.append(record)
     source = sources[0] if len(sources) == 1 else f"{len(sources)} runs:\n  " + "\n  ".join(sources)
     inputs = {Path(p).resolve() for p in args.path}
@@ -1702,6 +1754,14 @@ def _build_identify(sub: Any) -> None:
         "lon, rpm)",
     )
     p.add_argument(
+        "--length",
+        type=_float_in(0.1, 1000.0, "m"),
+        default=None,
+        metavar="L",
+        help="the ship's length [m], kept in the model file (the envs' option ranges and the "
+        "IMO ratios of 'shipgym simulate --model FIT.json' use it); default: the record's",
+    )
+    p.add_argument(
         "--max-gap",
         type=_float_in(1e-6, 1e6, "s"),
         default=None,
@@ -1755,6 +1815,97 @@ def _build_identify(sub: Any) -> None:
     p.set_defaults(handler=_run_identify)
 
 
+# ------------------------------------------------------------------------------------------
+# design
+# ------------------------------------------------------------------------------------------
+def _run_design(args: argparse.Namespace) -> int:
+    import json
+
+    from shipgym.benchmark.design import design_heading_autopilot, plot_heading_design
+    from shipgym.models import NOMOTO_MODEL_NAMES
+    from shipgym.models.model_file import load_model
+
+    json_path = _output_path(args.json, "--json", ".json")
+    plot_path = _output_path(args.plot, "--plot", ".png")
+    path = Path(args.model_file)
+    if not path.is_file():
+        raise ValueError(
+            f"model file {args.model_file!r} does not exist (expected the JSON that "
+            "shipgym identify --json writes)"
+        )
+    for out in (json_path, plot_path):
+        if out is not None and out.resolve() == path.resolve():
+            raise ValueError(f"output {str(out)!r} is the model file; refusing")
+    model = load_model(path)
+    if model.name not in NOMOTO_MODEL_NAMES:
+        raise ValueError(
+            f"{args.model_file!r} holds a {model.name!r} model (3-DOF manoeuvring); shipgym "
+            f"design takes a Nomoto-family model ({', '.join(NOMOTO_MODEL_NAMES)}: shipgym "
+            "identify LOG --model nomoto1 --json FILE)"
+        )
+    print(f"designing the heading autopilot for {args.model_file} ...", file=sys.stderr, flush=True)
+    design = design_heading_autopilot(model, omega_n=args.bandwidth, zeta=args.damping)
+    print(design.summary())
+    text = json.dumps(design.gains_document(), indent=2, allow_nan=False) + "\n"
+    outputs: list[tuple[Path, Callable[[Path], Any]]] = []
+    if json_path is not None:
+        outputs.append((json_path, lambda p: p.write_text(text, encoding="utf-8")))
+    if plot_path is not None:
+        outputs.append((plot_path, lambda p: plot_heading_design(design, p)))
+    write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}")
+    if json_path is not None:
+        print(
+            f"run it: {PROG} evaluate --env shipgym/NomotoHeading-v0 --controller classic "
+            f"--gains {json_path}"
+        )
+    return 0
+
+
+def _build_design(sub: Any) -> None:
+    p = sub.add_parser(
+        "design",
+        help="heading autopilot for an identified Nomoto-family ship, checked in simulation",
+        description=(
+            "Design the PID heading autopilot of a ship identified by shipgym identify --json "
+            "(nomoto1, nomoto2, norrbin or bech) by the rule of the classic controller of "
+            "shipgym/NomotoHeading-v0: pole placement on the first-order model that matches "
+            "the ship at the design bandwidth, bandwidth from the steering gear and the ship. "
+            "Prints the gains, the open-loop margins with the ship's input delay, the "
+            "simulated 10 and 30 deg heading steps and the open-loop 20/20 zigzag. --json "
+            "writes the gains for shipgym evaluate --gains."
+        ),
+    )
+    p.add_argument(
+        "model_file", metavar="FILE.json", help="model file (shipgym identify --json FILE.json)"
+    )
+    p.add_argument(
+        "--json", default=None, metavar="OUT", help="write the gains and the design as JSON"
+    )
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="OUT.png",
+        help="write the step responses, their rudder and the zigzag as a PNG",
+    )
+    p.add_argument(
+        "--bandwidth",
+        type=_float_in(1e-4, 10.0, "rad/s"),
+        default=None,
+        metavar="W",
+        help="closed-loop natural frequency [rad/s] (default: from the steering gear and ship)",
+    )
+    p.add_argument(
+        "--damping",
+        type=_float_in(0.05, 5.0, "(damping ratio)"),
+        default=0.8,
+        metavar="Z",
+        help="closed-loop relative damping (default: %(default)s)",
+    )
+    p.set_defaults(handler=_run_design)
+
+
 #: Subcommand name -> builder.
 SUBCOMMANDS: dict[str, Builder] = {
     "demo": _build_demo,
@@ -1765,6 +1916,7 @@ SUBCOMMANDS: dict[str, Builder] = {
     "train": _build_train,
     "benchmark": _build_benchmark,
     "identify": _build_identify,
+    "design": _build_design,
 }
 
 

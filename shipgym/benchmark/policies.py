@@ -36,11 +36,17 @@ agents the same way. Its few design parameters (:attr:`DESIGN` of each class) co
 ``classic-tuned``: the same structures with design parameters chosen by a grid search on the
 RL training seeds (:mod:`shipgym.benchmark.tuning`); the chosen values and the search's record
 ship in ``shipgym/benchmark/tuned/``.
+
+``classic`` with a gains file (``make_policy(..., gains=FILE)``, ``shipgym evaluate --gains``;
+NomotoHeading only): the same autopilot with exactly the gains, reference model, limits and
+offset of a gains document that ``shipgym design MODEL.json --json FILE`` wrote for an
+identified ship (:mod:`shipgym.benchmark.design`), :class:`NomotoHeadingGains`.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from functools import cache
 from pathlib import Path
 from typing import Any, ClassVar
@@ -101,18 +107,37 @@ def nomoto_heading_autopilot(
     (:func:`controllers.design_model`; the bandwidth from the steering gear and the ship
     unless ``omega_n`` is given), damping ``zeta``, reference model at ``reference_ratio``
     times the bandwidth (0: none)."""
-    y, gear = model.params, model.gear
-    if hasattr(y, "T1"):  # second-order Nomoto, Bech (linear part K b1 r)
-        args = (y.K, y.T1, y.T2, y.T3)
-        n1 = y.K * y.b1 if hasattr(y, "b1") else 1.0
-    else:  # first-order Nomoto, Norrbin (linear part n1 r)
-        args, n1 = (y.K, y.T), getattr(y, "n1", 1.0)
-    limits = {"actuator_time_constant": gear.time_constant, "max_command": gear.max_angle,
-              "max_rate": gear.max_rate}  # fmt: skip
-    K, T, omega = design_model(*args, n1=n1, omega=omega_n, **limits)
+    K, T1, T2, T3, n1 = nomoto_linear_yaw(model)
+    limits = steering_limits(model)
+    K, T, omega = design_model(K, T1, T2, T3, n1=n1, omega=omega_n, **limits)
     return HeadingAutopilot.from_nomoto(
         K, T, dt, omega_n=omega, zeta=zeta, reference_omega=reference_ratio * omega, **limits
     )
+
+
+def nomoto_linear_yaw(model: Any) -> tuple[float, float, float, float, float]:
+    """``(K, T1, T2, T3, n1)`` of a Nomoto-family ship's yaw response linearised about
+    straight running, ``r / delta = K (1 + T3 s) / (T1 T2 s^2 + (T1 + T2) s + n1)`` (the
+    arguments of :func:`controllers.design_model`): ``(K, T, 0, 0, n1)`` for the first-order
+    Nomoto (``n1 = 1``) and Norrbin models, ``(K, T1, T2, T3, 1)`` for the second-order
+    Nomoto and ``n1 = K b1`` for Bech's."""
+    y = model.params
+    if hasattr(y, "T1"):  # second-order Nomoto, Bech (linear part K b1 r)
+        n1 = y.K * y.b1 if hasattr(y, "b1") else 1.0
+        return float(y.K), float(y.T1), float(y.T2), float(y.T3), float(n1)
+    # first-order Nomoto, Norrbin (linear part n1 r)
+    return float(y.K), float(y.T), 0.0, 0.0, float(getattr(y, "n1", 1.0))
+
+
+def steering_limits(model: Any) -> dict[str, float]:
+    """The steering gear of a Nomoto-family ship as the keyword arguments of the design rule:
+    ``actuator_time_constant`` [s], ``max_command`` [rad], ``max_rate`` [rad/s]."""
+    gear = model.gear
+    return {
+        "actuator_time_constant": float(gear.time_constant),
+        "max_command": float(gear.max_angle),
+        "max_rate": float(gear.max_rate),
+    }
 
 
 def _rvg_heading_autopilot(
@@ -258,6 +283,189 @@ class NomotoHeadingClassic(ClassicPolicy):
         delta = self.pilot.update(self.t, state[self.ipsi], state[self.ir], setpoint)
         self.t += self.dt
         return np.array([delta / self.max_angle], dtype=np.float32)
+
+
+#: ``kind`` of the gains document that ``shipgym design --json`` writes
+#: (:meth:`shipgym.benchmark.design.HeadingAutopilotDesign.gains_document`) and
+#: ``make_policy("classic", ..., gains=...)`` reads.
+GAINS_KIND = "shipgym heading autopilot gains"
+#: The env and controller structure of a gains document: the classic policy of
+#: ``shipgym/NomotoHeading-v0``, a :class:`controllers.HeadingAutopilot` (PID on the heading
+#: error with the yaw rate fed back, third-order reference model, rudder limits).
+GAINS_ENV = "shipgym/NomotoHeading-v0"
+GAINS_STRUCTURE = "HeadingAutopilot"
+#: The ``autopilot`` section of a gains document: keyword arguments of
+#: :class:`controllers.HeadingAutopilot` and their units (``reference_omega``, ``max_command``,
+#: ``max_rate`` may be ``null``: none).
+GAINS_UNITS: dict[str, str] = {
+    "kp": "rad/rad", "ki": "rad/(rad s)", "kd": "rad s/rad", "reference_omega": "rad/s",
+    "reference_zeta": "-", "max_command": "rad", "max_rate": "rad/s", "offset": "rad",
+    "anti_windup": "back_calculation|conditional|none",
+}  # fmt: skip
+
+
+def heading_gains_document(
+    pilot: HeadingAutopilot, design: Mapping[str, Any] | None = None
+) -> dict[str, Any]:
+    """The gains document of ``pilot`` (JSON-ready): ``kind``, ``env``, ``controller``,
+    ``structure``, ``autopilot`` (the gains, reference model, limits and offset, SI units as
+    in :data:`GAINS_UNITS`), ``units`` and, if given, ``design`` (informative, not read)."""
+
+    def limit(value: float) -> float | None:
+        return float(value) if math.isfinite(value) else None
+
+    ref = pilot.reference
+    doc: dict[str, Any] = {
+        "kind": GAINS_KIND,
+        "env": GAINS_ENV,
+        "controller": "classic",
+        "structure": GAINS_STRUCTURE,
+        "autopilot": {
+            "kp": pilot.kp,
+            "ki": pilot.ki,
+            "kd": pilot.kd,
+            "reference_omega": None if ref is None else ref.omega,
+            "reference_zeta": 1.0 if ref is None else ref.zeta,
+            "max_command": limit(pilot.max_command),
+            "max_rate": limit(pilot.max_rate),
+            "offset": pilot.offset,
+            "anti_windup": pilot.anti_windup,
+        },
+        "units": dict(GAINS_UNITS),
+    }
+    if design is not None:
+        doc["design"] = dict(design)
+    return doc
+
+
+def load_gains(source: str | Path | Mapping[str, Any], env_id: str = GAINS_ENV) -> dict[str, Any]:
+    """The ``autopilot`` section of a gains document, checked for ``env_id``.
+
+    Parameters
+    ----------
+    source : str, Path or Mapping
+        A gains file (``shipgym design MODEL.json --json FILE``) or its parsed document.
+    env_id : str
+        The env the gains are to run on.
+
+    Returns
+    -------
+    dict
+        Keyword arguments of :class:`controllers.HeadingAutopilot` (without ``dt``).
+
+    Raises
+    ------
+    ValueError
+        For a missing or unreadable file, a file that is not JSON or not a gains document,
+        gains for another env or controller structure, and bad values.
+    """
+    import json
+
+    if isinstance(source, Mapping):
+        doc: Any = source
+        where = "the gains document"
+    else:
+        path = Path(source)
+        where = f"gains file {str(path)!r}"
+        if not path.is_file():
+            raise ValueError(f"{where} does not exist (write one with shipgym design ... --json)")
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{where} is not readable JSON: {exc}") from None
+    if not isinstance(doc, Mapping) or doc.get("kind") != GAINS_KIND:
+        kind = doc.get("kind") if isinstance(doc, Mapping) else type(doc).__name__
+        raise ValueError(
+            f"{where} is not a heading autopilot gains document (kind {kind!r}, expected "
+            f"{GAINS_KIND!r}: written by shipgym design MODEL.json --json FILE)"
+        )
+    if doc.get("env") != env_id:
+        raise ValueError(f"{where} holds gains for env {doc.get('env')!r}, not for {env_id!r}")
+    structure = (doc.get("controller"), doc.get("structure"))
+    if structure != ("classic", GAINS_STRUCTURE):
+        raise ValueError(
+            f"{where} holds controller {structure[0]!r} with structure {structure[1]!r}; the "
+            f"classic policy of {env_id} is 'classic' with structure {GAINS_STRUCTURE!r}"
+        )
+    autopilot = doc.get("autopilot")
+    keys = set(autopilot) if isinstance(autopilot, Mapping) else set()
+    if keys != set(GAINS_UNITS):
+        raise ValueError(
+            f"{where}: the autopilot section must have the keys {sorted(GAINS_UNITS)}, got "
+            f"{sorted(keys) if isinstance(autopilot, Mapping) else type(autopilot).__name__}"
+        )
+    gains = dict(autopilot)
+    for key, value in gains.items():
+        nullable = key in ("reference_omega", "max_command", "max_rate")
+        if key == "anti_windup" or (nullable and value is None):
+            continue
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{where}: autopilot {key} must be a number, got {value!r}")
+    try:
+        heading_autopilot_from_gains(gains, 1.0)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    return gains
+
+
+def heading_autopilot_from_gains(
+    gains: Mapping[str, Any],
+    dt: float,
+    *,
+    max_command: float | None = None,
+    max_rate: float | None = None,
+) -> HeadingAutopilot:
+    """The :class:`controllers.HeadingAutopilot` of a gains document's ``autopilot`` section
+    (:func:`load_gains`) with sample time ``dt`` [s]. ``max_command`` [rad] and ``max_rate``
+    [rad/s] are the actuator's limits: where they are tighter than the document's, they
+    count (the anti-windup must see the limit the rudder really has)."""
+    g = dict(gains)
+
+    def tighter(mine: float | None, theirs: float | None) -> float | None:
+        values = [v for v in (mine, theirs) if v is not None]
+        return min(values) if values else None
+
+    return HeadingAutopilot(
+        g["kp"],
+        g["ki"],
+        g["kd"],
+        dt,
+        reference_omega=g["reference_omega"],
+        reference_zeta=g["reference_zeta"],
+        max_command=tighter(g["max_command"], max_command),
+        max_rate=tighter(g["max_rate"], max_rate),
+        offset=g["offset"],
+        anti_windup=g["anti_windup"],
+    )
+
+
+class NomotoHeadingGains(NomotoHeadingClassic):
+    """The classic NomotoHeading policy with the gains of a gains document (``shipgym design
+    MODEL.json --json FILE``) instead of the design rule on the nominal ship.
+
+    Parameters
+    ----------
+    gains : Mapping
+        The document's ``autopilot`` section (:func:`load_gains`). The env's steering gear
+        limits the command where it is tighter than the document's limits.
+    """
+
+    def __init__(self, gains: Mapping[str, Any]) -> None:
+        super().__init__()
+        self.gains = dict(gains)
+
+    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+        model = env.task.model
+        gear = model.gear
+        self.max_angle = gear.max_angle
+        self.dt = env.dt
+        self.ipsi, self.ir = model.index("psi"), model.index("r")
+        self.pilot = heading_autopilot_from_gains(
+            self.gains, env.dt, max_command=gear.max_angle, max_rate=gear.max_rate
+        )
+        state = _measured(info)
+        self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
+        self.t = 0.0
 
 
 class RVGHeadingClassic(ClassicPolicy):
@@ -443,15 +651,32 @@ def classic_policy(env_id: str, **design: float | None) -> ClassicPolicy:
     return CLASSIC[env_task(env_id)](nominal_ship(env_id), **design)
 
 
-def make_policy(name: str, env_id: str, agents_dir: str | Path | None = None) -> Any:
+def make_policy(
+    name: str,
+    env_id: str,
+    agents_dir: str | Path | None = None,
+    *,
+    gains: str | Path | Mapping[str, Any] | None = None,
+) -> Any:
     """The policy ``name`` (one of :data:`POLICIES`) for ``env_id``.
 
     ``classic-tuned`` uses the tuned design parameters shipped for ``env_id``
     (:func:`shipgym.benchmark.tuning.load_tuned`); ``ppo`` and ``sac`` load the shipped
-    agents, or those in ``agents_dir``.
+    agents, or those in ``agents_dir``. ``gains`` (a gains file of ``shipgym design --json``
+    or its document) makes the ``classic`` policy of ``shipgym/NomotoHeading-v0`` use exactly
+    those gains (:class:`NomotoHeadingGains`); it is refused with any other controller or env.
     """
     if env_id not in ENV_IDS:
         raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    if gains is not None:
+        if name != "classic":
+            raise ValueError(f"gains go with the classic controller, not with {name!r}")
+        if env_task(env_id) != "NomotoHeading":
+            raise ValueError(
+                f"gains set the heading autopilot of {GAINS_ENV}; the classic controller of "
+                f"{env_id} has another structure"
+            )
+        return NomotoHeadingGains(load_gains(gains, env_id))
     if name == "zero":
         return ZeroPolicy()
     if name == "classic":
