@@ -6,9 +6,11 @@ Subcommands::
     shipgym bench [--steps N] [--num-envs N] [--repeats N] [--vec-steps N] [--json OUT]
                   [--plot OUT.png]
     shipgym envs
-    shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME] [...] [--json F] [--plot P]
+    shipgym simulate zigzag|turning|pullout|spiral|imo [--model NAME|FIT.json] [...] [--json F]
+                     [--plot P]
     shipgym evaluate --env ID [--controller classic|classic-tuned|ppo|sac|zero] [--episodes N]
-                     [--seed S] [--agents DIR] [--gains FILE] [--json OUT] [--plot DIR]
+                     [--model NAME|FIT.json] [--gains FILE]
+                     [--seed S] [--agents DIR] [--json OUT] [--plot DIR]
                      [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N]
     shipgym train --env ID --algo ppo|sac [--timesteps N] [--seed S] [--out DIR]
                   [--tensorboard DIR | --no-tensorboard] [--overwrite]
@@ -680,7 +682,19 @@ def _run_evaluate(args: argparse.Namespace) -> int:
             )
         if ray is not None:
             raise ValueError("--gains runs the episodes here; drop --ray")
-    policy = make_policy(args.controller, args.env, args.agents, gains=args.gains)
+    env_kwargs: dict[str, Any] = {}
+    if args.max_current_speed is not None:
+        env_kwargs["max_current_speed"] = args.max_current_speed
+    if args.model is not None:
+        from shipgym.benchmark.policies import GAINS_ENV
+
+        if args.env != GAINS_ENV:
+            raise ValueError(
+                f"--model sets the ship of {GAINS_ENV} (a Nomoto-family model or an identified "
+                f"model file); {args.env} sails its own ship"
+            )
+        env_kwargs["model"] = args.model
+    policy = make_policy(args.controller, args.env, args.agents, gains=args.gains, model=args.model)
     if hasattr(policy, "meta"):
         from shipgym.benchmark.runner import check_seeds_disjoint
 
@@ -688,9 +702,6 @@ def _run_evaluate(args: argparse.Namespace) -> int:
             check_seeds_disjoint(policy.meta, args.seed, args.episodes)
         except ValueError as exc:
             print(f"{PROG}: warning: {exc}", file=sys.stderr)
-    env_kwargs = (
-        {} if args.max_current_speed is None else {"max_current_speed": args.max_current_speed}
-    )
     try:
         if ray is None:
             result = evaluate(
@@ -785,6 +796,15 @@ def _build_evaluate(sub: Any) -> None:
         metavar="FILE",
         help="gains of the classic NomotoHeading autopilot (shipgym design MODEL.json --json "
         "FILE) instead of the design rule on the nominal ship",
+    )
+    p.add_argument(
+        "--model",
+        default=None,
+        type=_model_name,
+        metavar="NAME|FIT.json",
+        help="the ship of shipgym/NomotoHeading-v0: a Nomoto-family model or an identified "
+        "model file (shipgym identify --json FIT.json); the classic controllers are designed "
+        "on it (default: the env's)",
     )
     p.add_argument("--json", default=None, metavar="OUT", help="write the summary as JSON")
     p.add_argument(
@@ -1857,8 +1877,8 @@ def _run_design(args: argparse.Namespace) -> int:
         print(f"wrote {target}")
     if json_path is not None:
         print(
-            f"run it: {PROG} evaluate --env shipgym/NomotoHeading-v0 --controller classic "
-            f"--gains {json_path}"
+            f"run it on the identified ship: {PROG} evaluate --env shipgym/NomotoHeading-v0 "
+            f"--model {args.model_file} --controller classic --gains {json_path}"
         )
     return 0
 

@@ -66,6 +66,7 @@ from controllers.los import LOSGuidance
 from controllers.paths import WaypointPath
 from shipgym.envs import ENV_IDS, env_task
 from shipgym.models import make_model
+from shipgym.models.model_file import is_model_file
 from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEED, RVGParams
 
 
@@ -271,7 +272,11 @@ class NomotoHeadingClassic(ClassicPolicy):
         self.max_angle = gear.max_angle
         self.dt = env.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        nominal = make_model(self.nominal, gear=gear, surge=model.surge)
+        nominal = (
+            make_model(self.nominal)  # an identified ship: its own gear, speed and delay
+            if is_model_file(self.nominal)
+            else make_model(self.nominal, gear=gear, surge=model.surge)
+        )
         self.pilot = nomoto_heading_autopilot(nominal, env.dt, **self.design)
         state = _measured(info)
         self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
@@ -645,10 +650,10 @@ def nominal_ship(env_id: str) -> str:
     return str(kwargs.get("params", "seed001"))
 
 
-def classic_policy(env_id: str, **design: float | None) -> ClassicPolicy:
-    """The classic policy of ``env_id`` on its nominal ship with design parameters
-    ``design`` (the rest at their design-rule values)."""
-    return CLASSIC[env_task(env_id)](nominal_ship(env_id), **design)
+def classic_policy(env_id: str, ship: str | None = None, **design: float | None) -> ClassicPolicy:
+    """The classic policy of ``env_id`` designed on ``ship`` (default: its nominal ship) with
+    design parameters ``design`` (the rest at their design-rule values)."""
+    return CLASSIC[env_task(env_id)](ship or nominal_ship(env_id), **design)
 
 
 def make_policy(
@@ -657,6 +662,7 @@ def make_policy(
     agents_dir: str | Path | None = None,
     *,
     gains: str | Path | Mapping[str, Any] | None = None,
+    model: str | None = None,
 ) -> Any:
     """The policy ``name`` (one of :data:`POLICIES`) for ``env_id``.
 
@@ -665,9 +671,16 @@ def make_policy(
     agents, or those in ``agents_dir``. ``gains`` (a gains file of ``shipgym design --json``
     or its document) makes the ``classic`` policy of ``shipgym/NomotoHeading-v0`` use exactly
     those gains (:class:`NomotoHeadingGains`); it is refused with any other controller or env.
+    ``model`` (a Nomoto-family model name or an identified model file, the env's ``model``)
+    is the ship the classic controllers of ``shipgym/NomotoHeading-v0`` are designed on
+    (default: the env's nominal ship).
     """
     if env_id not in ENV_IDS:
         raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
+    if model is not None and env_task(env_id) != "NomotoHeading":
+        raise ValueError(
+            f"a model ({model!r}) sets the ship of {GAINS_ENV}; {env_id} sails its own ship"
+        )
     if gains is not None:
         if name != "classic":
             raise ValueError(f"gains go with the classic controller, not with {name!r}")
@@ -680,11 +693,11 @@ def make_policy(
     if name == "zero":
         return ZeroPolicy()
     if name == "classic":
-        return classic_policy(env_id)
+        return classic_policy(env_id, model)
     if name == "classic-tuned":
         from shipgym.benchmark.tuning import load_tuned
 
-        return classic_policy(env_id, **load_tuned(env_id)["design"])
+        return classic_policy(env_id, model, **load_tuned(env_id)["design"])
     if name in ("ppo", "sac"):
         from shipgym.rl.agents import load_agent
 

@@ -322,7 +322,12 @@ class EpisodeBatch:
         """Evaluate the batch here (on a Ray worker: the task's body)."""
         result = evaluate(
             self.env_id,
-            make_policy(self.controller, self.env_id, self.agents_dir),
+            make_policy(
+                self.controller,
+                self.env_id,
+                self.agents_dir,
+                model=(self.scenario.env_kwargs or {}).get("model"),
+            ),
             self.controller,
             episodes=self.episodes,
             seed=self.seed,

@@ -1,8 +1,9 @@
 """Model files: an identified ship as a model the rest of the package takes.
 
 ``shipgym identify ... --json fit.json`` writes the fitted model into its report under one key
-per family, and :func:`load_model` (also ``make_model("fit.json")``, the envs' ``model="fit.json"``
-and ``shipgym simulate|evaluate|design --model fit.json``) builds the :class:`ShipModel` from it:
+per family, and :func:`load_model` builds the :class:`ShipModel` from it; so do
+``make_model("fit.json")``, the envs' ``model="fit.json"``, ``shipgym simulate|evaluate --model
+fit.json`` and ``shipgym design fit.json``:
 
 * ``"nomoto"`` (the Nomoto family, seed 000/002/004; written by :func:`nomoto_document`)::
 
