@@ -8,6 +8,7 @@ its own column names, several delimiters and a decimal comma).
 
 from __future__ import annotations
 
+import datetime
 import json
 import math
 import warnings
@@ -24,6 +25,7 @@ from shipgym.models.delay import DelayLine
 from shipgym.models.model_file import load_model, nomoto_document
 from shipgym.sysid import Record, generate_record, identify, load
 from shipgym.sysid.data import SysidDataWarning, measured_root
+from shipgym.sysid.nmea_writer import write_nmea
 from shipgym.sysid.table import parse_columns
 
 pytestmark = pytest.mark.xdist_group("test_user_logs")
@@ -261,6 +263,18 @@ def _bad_files(tmp: Path) -> Iterator[tuple[str, list[str], list[str]]]:
         [str(_write(tmp, "d.csv", text)), "--columns", cmap],
         ["time goes backwards at 4 -> 3.5 s in column 't' (line 7)", "expected increasing"],
     )
+    t = np.arange(40.0)
+    no_heading = write_nmea(
+        tmp / "f.nmea",
+        start=datetime.datetime(2026, 6, 1, 12, tzinfo=datetime.UTC),
+        time=t, psi=0.01 * t, delta=np.zeros(40), U=np.full(40, 3.0), x=3.0 * t, y=0 * t,
+        rates={"RMC": 1.0, "RSA": 1.0},
+    )  # fmt: skip
+    yield (
+        "an NMEA log with no heading sentence",
+        [str(no_heading)],
+        ["no heading sentence (HDT, THS or HDG) in 80 sentences", "expected a heading"],
+    )
     yield (
         "fewer than two samples",
         [str(_write(tmp, "e.csv", "t,rudder,hdg\n0,1,2\n")), "--columns", cmap],
@@ -445,3 +459,72 @@ def test_log_to_model_to_autopilot_verified_in_simulation(
     # --model goes with the Nomoto env only; a gains file with another model's env is fine
     assert main(["evaluate", "--env", "shipgym/RVGHeading-v1", "--model", str(fit)]) == 2
     assert "sails its own ship" in capsys.readouterr().err
+
+
+NMEA_RATES = {"HDT": 2.0, "RSA": 2.0, "ROT": 1.0, "RMC": 1.0, "VTG": 1.0, "GGA": 0.5, "ZDA": 0.2}
+
+
+@pytest.fixture(scope="module")
+def nmea_record(truth: Record, tmp_path_factory: pytest.TempPathFactory) -> Record:
+    """The same ship as an NMEA 0183 log: mixed sentence rates, one bad checksum, and a start
+    at 23:58:00 on New Year's Eve so the log crosses midnight into the next year."""
+    path = tmp_path_factory.mktemp("logs") / "voyage.nmea"
+    write_nmea(
+        path,
+        start=datetime.datetime(2026, 12, 31, 23, 58, 0, tzinfo=datetime.UTC),
+        time=truth.time,
+        psi=truth.psi,
+        r=truth.r,
+        delta=truth.delta,
+        U=truth.U,
+        x=truth.x,
+        y=truth.y,
+        rates=NMEA_RATES,
+        bad_checksums=(100,),
+    )
+    with pytest.warns(SysidDataWarning, match="bad checksum"):
+        return load(path)
+
+
+def test_csv_and_nmea_logs_import_to_the_same_record(
+    truth: Record, csv_record: Record, nmea_record: Record
+) -> None:
+    nmea = nmea_record
+    assert nmea.meta["source"] == "nmea" and nmea.meta["start_time"].startswith("2026-12-31T23:58")
+    assert any("bad checksum" in r for r in nmea.meta["repairs"])
+    np.testing.assert_allclose(nmea.time, csv_record.time, atol=1e-6)  # one 0.5 s grid
+    # the sentences' resolution: 0.01 deg, 0.01 deg/min, 0.01 kn (half of it by rounding)
+    tol = {"psi": math.radians(0.005), "delta": math.radians(0.005)}
+    off = []
+    for name, atol in tol.items():
+        a, b = getattr(nmea, name), getattr(csv_record, name)
+        bad = np.flatnonzero(np.abs(a - b) > atol)
+        # the sentence with the bad checksum is missing: its sample is interpolated
+        np.testing.assert_allclose(a[bad], 0.5 * (b[bad - 1] + b[bad + 1]), atol=atol)
+        off += list(bad)
+    assert len(off) == 1
+    whole = np.flatnonzero(np.isclose(np.mod(csv_record.time, 1.0), 0.0))  # ROT, RMC at 1 Hz
+    rot = math.radians(0.005) / 60.0
+    np.testing.assert_allclose(nmea.r[whole], csv_record.r[whole], atol=rot)
+    np.testing.assert_allclose(nmea.U[whole], csv_record.U[whole], atol=0.005 * KNOT)
+    # between the 1 Hz samples: linear interpolation of the noisy truth
+    half = np.setdiff1d(np.arange(nmea.n), whole)
+    expected = 0.5 * (csv_record.r[half - 1] + csv_record.r[half + 1])
+    np.testing.assert_allclose(nmea.r[half], expected, atol=rot)
+
+
+def test_csv_and_nmea_identify_the_same_ship(
+    truth: Record, csv_record: Record, nmea_record: Record
+) -> None:
+    true = truth.meta["truth"]["params"]
+    offset = -true["n0"] / true["K"]
+    fits = [identify(rec, "nomoto1", max_effects=1) for rec in (csv_record, nmea_record)]
+    for res in fits:
+        assert res.effect_names == ["rudder_offset"]
+        got = res.parameters_after
+        assert got["K"] == pytest.approx(true["K"], rel=0.02)
+        assert got["T"] == pytest.approx(true["T"], rel=0.02)
+        assert got["delta0"] == pytest.approx(offset, rel=0.02)
+    a, b = (f.parameters_after for f in fits)
+    for key in ("K", "T", "delta0"):
+        assert b[key] == pytest.approx(a[key], rel=0.02)
