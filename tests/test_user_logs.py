@@ -528,3 +528,23 @@ def test_csv_and_nmea_identify_the_same_ship(
     a, b = (f.parameters_after for f in fits)
     for key in ("K", "T", "delta0"):
         assert b[key] == pytest.approx(a[key], rel=0.02)
+
+
+def test_the_worked_examples_logs_read_as_documented() -> None:
+    """``examples/`` (README, "Worked example"): the CSV with its column map and the NMEA log
+    with its midnight, its bad checksum and its 20 s without the gyro."""
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    columns = (
+        "time=time_utc:datetime,delta=-rudder_angle:deg,psi=gyro_heading:deg,r=rot:deg/min,"
+        "U=sog:kn,lat=lat,lon=lon"
+    )
+    csv = load(examples / "myship.csv", columns=columns)
+    assert (csv.n, csv.meta["start_time"]) == (2251, "2026-12-31T23:55:00+00:00")
+    assert csv.dt == pytest.approx(0.4)
+    with pytest.warns(SysidDataWarning, match="bad checksum"):
+        nmea = load(examples / "voyage.nmea")
+    assert nmea.meta["start_time"].startswith("2026-12-31T23:55:00")
+    assert [round(b - a) for a, b in nmea.meta["segments"]] == [420, 460]
+    # the two logs of one voyage agree where both have the heading
+    both = nmea.time[np.searchsorted(nmea.time, csv.time[csv.time < 419.0])]
+    np.testing.assert_allclose(both, csv.time[csv.time < 419.0], atol=1e-6)
