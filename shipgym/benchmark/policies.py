@@ -272,15 +272,19 @@ class NomotoHeadingClassic(ClassicPolicy):
         self.max_angle = gear.max_angle
         self.dt = env.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        nominal = (
-            make_model(self.nominal)  # an identified ship: its own gear, speed and delay
-            if is_model_file(self.nominal)
-            else make_model(self.nominal, gear=gear, surge=model.surge)
-        )
-        self.pilot = nomoto_heading_autopilot(nominal, env.dt, **self.design)
+        self.pilot = self._autopilot(model, env.dt)
         state = _measured(info)
         self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
         self.t = 0.0
+
+    def _autopilot(self, model: Any, dt: float) -> HeadingAutopilot:
+        """The design rule on the nominal ship (with the env's gear and speed)."""
+        nominal = (
+            make_model(self.nominal)  # an identified ship: its own gear, speed and delay
+            if is_model_file(self.nominal)
+            else make_model(self.nominal, gear=model.gear, surge=model.surge)
+        )
+        return nomoto_heading_autopilot(nominal, dt, **self.design)
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
@@ -459,18 +463,12 @@ class NomotoHeadingGains(NomotoHeadingClassic):
         super().__init__()
         self.gains = dict(gains)
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
-        model = env.task.model
+    def _autopilot(self, model: Any, dt: float) -> HeadingAutopilot:
+        """The document's gains, limited by the env's steering gear."""
         gear = model.gear
-        self.max_angle = gear.max_angle
-        self.dt = env.dt
-        self.ipsi, self.ir = model.index("psi"), model.index("r")
-        self.pilot = heading_autopilot_from_gains(
-            self.gains, env.dt, max_command=gear.max_angle, max_rate=gear.max_rate
+        return heading_autopilot_from_gains(
+            self.gains, dt, max_command=gear.max_angle, max_rate=gear.max_rate
         )
-        state = _measured(info)
-        self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
-        self.t = 0.0
 
 
 class RVGHeadingClassic(ClassicPolicy):
