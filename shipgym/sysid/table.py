@@ -681,16 +681,17 @@ def record_from_arrays(
     if ok.sum() < 2:
         raise ValueError(f"{where}: {int(ok.sum())} complete samples; expected at least two")
     # exact duplicates and quantised stamps are the data module's business (good rows only)
+    # the rows of a missing value are removed; where they were, the segments split (the mark
+    # travels with its row through the time repairs, which may drop duplicate rows)
     keep = np.flatnonzero(ok)
-    table = np.column_stack([data[ch][keep] for ch in data])
+    after_hole = np.zeros(keep.size)
+    after_hole[1:] = np.diff(keep) > 1
+    table = np.column_stack([*(data[ch][keep] for ch in data), after_hole])
     t_good, table = _repair_time(data["time"][keep], table, out_meta)
+    gaps_at = table[:, -1] > 0.0
     data = {ch: table[:, j] for j, ch in enumerate(data)}
     data["time"] = t_good
-    # the rows of a missing value are removed; where they were, the segments split
-    gaps_at = np.zeros(t_good.size, dtype=bool)
     if n_missing:
-        holes = np.flatnonzero(np.diff(keep) > 1) + 1  # first kept row after a hole
-        gaps_at[holes[holes < t_good.size]] = True
         _warn(out_meta, f"{n_missing} rows miss a value of a mapped channel: treated as gaps")
     segs = _segments_with_breaks(t_good, gaps_at, max_gap_s)
     short = [(a, b) for a, b in segs if b - a < MIN_SEGMENT_SAMPLES]
@@ -722,17 +723,22 @@ def record_from_arrays(
     col_names = {"time": "time", "psi": "psi", "r": "r", "delta": "delta", "U": "U"}
     col_names.update({k: v for k, v in (names or {}).items() if k in col_names})
     r_in = data.get("r")
-    _check_units(
-        t,
-        data["psi"][idx],
-        None if r_in is None else r_in[idx],
-        data["delta"][idx],
-        out_meta,
-        names=col_names,
-        U=None if data.get("U") is None else data["U"][idx],
-        x=None if data.get("x") is None else data["x"][idx],
-        y=None if data.get("y") is None else data["y"][idx],
-    )
+    for a, b in segs:  # each stretch on its own: nothing is compared across a gap
+
+        def part(ch: str, a: int = a, b: int = b) -> np.ndarray | None:
+            return None if data.get(ch) is None else data[ch][a:b]
+
+        _check_units(
+            data["time"][a:b],
+            data["psi"][a:b],
+            part("r"),
+            data["delta"][a:b],
+            out_meta,
+            names=col_names,
+            U=part("U"),
+            x=part("x"),
+            y=part("y"),
+        )
     psi_parts, r_parts = [], []
     prev_end: float | None = None
     for a, b in segs:
