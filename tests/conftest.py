@@ -6,7 +6,8 @@ that started them (their ``tmp_path`` bases are ``pytest/gw<N>`` in it). Whateve
 test leaves there outside pytest's own ``tmp_path`` folders (an ``SB3-<date>`` logger folder, a
 temporary file not cleaned up) fails the run with the names of what was left; the folder is
 removed either way, so a test run leaves nothing in the system's temporary directory. Torch runs
-on one thread (tiny networks).
+on one thread (tiny networks). A cold kernel cache is filled before the tests start
+(:func:`shipgym.warmup.warm_cache`).
 """
 
 from __future__ import annotations
@@ -41,6 +42,13 @@ def pytest_configure(config: pytest.Config) -> None:
         config.option.basetemp = str(root / _PYTEST_DIR)
     os.environ["TMPDIR"] = str(_root())
     tempfile.tempdir = str(_root())
+    if not _is_worker(config):
+        # a cold kernel cache is filled once, by two processes at once, before the workers
+        # start: otherwise every worker (and every Ray worker and command the tests start)
+        # compiles the same kernels
+        from shipgym.warmup import warm_cache
+
+        warm_cache()
     # the tests' networks are tiny: torch's thread pool only adds synchronisation, and on
     # shared cores (a loaded CI machine) it makes each layer several times slower
     os.environ.setdefault("OMP_NUM_THREADS", "1")

@@ -52,3 +52,33 @@ def test_unreadable_cache_entry_is_recompiled_and_replaced(tmp_path: Path) -> No
     clean = _run(cache)
     assert clean.returncode == 0, clean.stderr
     assert "unreadable" not in clean.stderr
+
+
+_SIMULATE = (
+    "import numpy as np\n"
+    "from shipgym.models import integrate, make_model\n"
+    "m = make_model('nomoto2')\n"
+    "m.simulate(np.zeros(m.nx), np.zeros((3, m.nu)), 0.1)\n"
+    "print(len(integrate.rk4_step_kernel.stats.cache_hits),"
+    " len(integrate.rk4_step_kernel.stats.cache_misses))\n"
+)
+
+
+def test_the_warm_up_fills_the_cache_that_later_processes_load(tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    env = {**os.environ, "SHIPGYM_CACHE_DIR": str(cache)}
+    env.pop("SHIPGYM_NO_CACHE", None)
+
+    def run(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, *args], env=env, capture_output=True, text=True, timeout=600
+        )
+
+    bad = run("-m", "shipgym.warmup", "kernels")
+    assert bad.returncode == 2 and "unknown warm-up part(s) ['kernels']" in bad.stderr
+    warm = run("-m", "shipgym.warmup", "models")
+    assert warm.returncode == 0 and "shipgym warm-up: models in" in warm.stdout, warm.stderr
+    # a later process compiles nothing for a model simulation: it loads the kernel
+    later = run("-c", _SIMULATE)
+    assert later.returncode == 0, later.stderr
+    assert later.stdout.split() == ["1", "0"]
