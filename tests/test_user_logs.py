@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from shipgym.cli import main
+from shipgym.envs.tasks import IDENTIFIED_SHIP_LENGTH
 from shipgym.models import Nomoto1Params, Nomoto2Params, make_model
 from shipgym.models.delay import DelayLine
 from shipgym.models.model_file import load_model, nomoto_document
@@ -91,6 +92,14 @@ def test_the_csv_identifies_the_truth_within_two_percent(truth: Record, csv_reco
     doc = res.to_dict()["nomoto"]
     assert doc["rudder_offset_rad"] == pytest.approx(offset, rel=0.02)
     assert doc["speed_m_s"] == pytest.approx(7.7, rel=1e-3)
+    # the result is a model with its offset: as a ShipModel, a fit's model and an env's ship
+    ship = res.ship_model()
+    assert ship.name == "norrbin" and ship.params.n0 == pytest.approx(-got["K"] * got["delta0"])
+    assert res.final.model().params == ship.params
+    env = gym.make("shipgym/NomotoHeading-v0", model=res)
+    assert env.unwrapped.task.model.params == ship.params
+    # a table states no length: the envs take a small craft's, so the option ranges are wide
+    assert env.unwrapped.task.ship_length == IDENTIFIED_SHIP_LENGTH
 
 
 @pytest.mark.parametrize(

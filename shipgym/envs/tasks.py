@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import functools
 import math
-import os
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -566,12 +565,14 @@ class NomotoHeadingTask(HeadingTask):
     def __init__(
         self,
         n: int,
-        model: str | os.PathLike[str] | ShipModel = "nomoto1",
+        model: Any = "nomoto1",
         max_current_speed: float = 1.0,
         setpoint_interval: float = 200.0,
     ) -> None:
+        if isinstance(getattr(model, "model_file", None), Mapping):
+            model = model.model_file  # an identification result: its model file
         ship = nomoto_ship(model)
-        if isinstance(model, str | os.PathLike) and is_model_file(model):
+        if isinstance(model, Mapping) or is_model_file(model):
             length = model_info(model).get("length_m")
             # an identified ship of unknown length: a small craft's, so the ranges are wide
             self.ship_length = float(length) if length else IDENTIFIED_SHIP_LENGTH
@@ -608,10 +609,11 @@ reset options: a short ship allows fast turns)."""
 
 def nomoto_ship(model: Any) -> ShipModel:
     """The Nomoto-family ship of ``shipgym/NomotoHeading-v0``: a model name, a model file
-    (``shipgym identify --json``) or a :class:`ShipModel` of the family."""
+    (``shipgym identify --json``) or its parsed document, or a :class:`ShipModel` of the
+    family."""
     if isinstance(model, ShipModel):
         ship = model
-    elif isinstance(model, str | os.PathLike) and is_model_file(model):
+    elif isinstance(model, Mapping) or is_model_file(model):
         ship = load_model(model)
     elif isinstance(model, str) and model in NOMOTO_MODEL_NAMES:
         return make_model(model)

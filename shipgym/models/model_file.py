@@ -50,7 +50,14 @@ from shipgym.models.nomoto import (
 )
 from shipgym.models.vmm import VMMParams
 
-__all__ = ["MODEL_FILE_KEYS", "is_model_file", "load_model", "model_info", "nomoto_document"]
+__all__ = [
+    "MODEL_FILE_KEYS",
+    "is_model_file",
+    "load_model",
+    "model_info",
+    "nomoto_document",
+    "with_rudder_offset",
+]
 
 MODEL_FILE_KEYS: tuple[str, ...] = ("nomoto", "vmm", "kvlcc2")
 """The family keys of a model file."""
@@ -172,20 +179,37 @@ def _nomoto(doc: Mapping[str, Any], where: str) -> ShipModel:
         yaw = cls(**params)
     except TypeError as exc:
         raise ValueError(f"{where}: parameters of {name} {params}: {exc}") from None
-    if offset and name == "nomoto1":  # the same equation with the offset as the bias
-        name, yaw = "norrbin", NorrbinParams(K=yaw.K, T=yaw.T, n0=-yaw.K * offset, n1=1.0,
-                                             n2=0.0, n3=0.0)  # fmt: skip
-    elif offset and name == "nomoto2":
-        name = "bech"
-        yaw = BechParams(K=yaw.K, T1=yaw.T1, T2=yaw.T2, T3=yaw.T3, b0=-offset, b1=1.0 / yaw.K,
-                         b2=0.0, b3=0.0)  # fmt: skip
-    elif offset:
-        bias = "n0" if name == "norrbin" else "b0"
-        raise ValueError(
-            f"{where}: a {name} model carries its offset in its bias ({bias}); expected "
-            f"rudder_offset_rad 0, got {offset!r}"
-        )
+    try:
+        name, yaw = with_rudder_offset(name, yaw, offset)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
     return make_model(name, yaw, gear=gear, surge=surge, input_delay=delay)
+
+
+def with_rudder_offset(name: str, yaw: Any, offset: float) -> tuple[str, Any]:
+    """The yaw model that responds to ``delta + offset`` as ``(name, params)``: for
+    ``nomoto1`` and ``nomoto2`` the bias of the same equation (a ``norrbin`` model with
+    ``n0 = -K offset``, ``n1 = 1``, ``n2 = n3 = 0``; a ``bech`` model with ``b0 = -offset``,
+    ``b1 = 1 / K``, ``b2 = b3 = 0``); unchanged without an offset.
+
+    Raises
+    ------
+    ValueError
+        For an offset of a ``norrbin`` or ``bech`` model, which carries it in ``n0``/``b0``.
+    """
+    if not offset:
+        return name, yaw
+    if name == "nomoto1":
+        return "norrbin", NorrbinParams(K=yaw.K, T=yaw.T, n0=-yaw.K * offset, n1=1.0, n2=0.0,
+                                        n3=0.0)  # fmt: skip
+    if name == "nomoto2":
+        return "bech", BechParams(K=yaw.K, T1=yaw.T1, T2=yaw.T2, T3=yaw.T3, b0=-offset,
+                                  b1=1.0 / yaw.K, b2=0.0, b3=0.0)  # fmt: skip
+    bias = "n0" if name == "norrbin" else "b0"
+    raise ValueError(
+        f"a {name} model carries its rudder offset in its bias ({bias}); expected an offset of "
+        f"0, got {offset!r}"
+    )
 
 
 def load_model(source: str | os.PathLike[str] | Mapping[str, Any]) -> ShipModel:

@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from shipgym.models import ShipModel
+from shipgym.models.model_file import load_model
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import Candidate, ModelFamily, get_family, jsonable
 from shipgym.sysid.fit import excitation_problems, no_excitation_error
@@ -101,6 +103,19 @@ class IdentificationResult:
     rounds: list[dict[str, Any]] = field(default_factory=list)
     runtime_s: float = 0.0
     model_file: dict[str, Any] = field(default_factory=dict)
+
+    def ship_model(self) -> ShipModel:
+        """The identified ship with its effects (:func:`shipgym.models.model_file.
+        load_model` of :attr:`model_file`); the envs take this result as ``model=`` too.
+
+        Raises
+        ------
+        ValueError
+            For a family that writes no model file (``rvg3dof``).
+        """
+        if not self.model_file:
+            raise ValueError(f"a {self.model!r} identification writes no model file")
+        return load_model(self.model_file)
 
     @property
     def effect_names(self) -> list[str]:

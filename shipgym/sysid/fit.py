@@ -88,6 +88,7 @@ from shipgym.models import (
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.base import MODEL_NAMES
 from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
+from shipgym.models.model_file import with_rudder_offset
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
 
 __all__ = [
@@ -359,8 +360,11 @@ class FitResult:
     info: dict[str, Any] = field(default_factory=dict)
 
     def model(self) -> ShipModel:
-        """The fitted model, ``make_model(name, params, gear=..., surge=...)``."""
-        return make_model(self.model_name, self.params, gear=self.gear, surge=self.surge)
+        """The fitted model, ``make_model(name, params, gear=..., surge=...)``, its rudder offset
+        ``delta0`` included as the bias of the same equation
+        (:func:`shipgym.models.model_file.with_rudder_offset`)."""
+        name, params = with_rudder_offset(self.model_name, self.params, self.delta0)
+        return make_model(name, params, gear=self.gear, surge=self.surge)
 
     def summary(self) -> str:
         """One line per estimate: ``name = value ± stderr``."""
