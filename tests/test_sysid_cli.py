@@ -209,6 +209,10 @@ def test_identify_rvg3dof(tmp_path: Path) -> None:
         assert {"psi_rms_deg", "r_rms_deg_s", "xy_rms_m", "u_rms_m_s"} <= set(err)
     assert "u RMS [m/s]" in stdout
     assert _is_png(out_png)
+    # the report is a model file of the identified Gunnerus
+    from shipgym.models.model_file import load_model
+
+    assert load_model(out_json).name == "rvg3dof"
 
 
 # ------------------------------------------------------------------------------------------

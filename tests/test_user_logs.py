@@ -13,6 +13,7 @@ import json
 import math
 import warnings
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import gymnasium as gym
@@ -557,3 +558,33 @@ def test_the_worked_examples_logs_read_as_documented() -> None:
     # the two logs of one voyage agree where both have the heading
     both = nmea.time[np.searchsorted(nmea.time, csv.time[csv.time < 419.0])]
     np.testing.assert_allclose(both, csv.time[csv.time < 419.0], atol=1e-6)
+
+
+def test_an_identified_gunnerus_is_a_model_file_with_its_azimuth_offset(tmp_path: Path) -> None:
+    """The rvg3dof entry of a model file keeps every term of the fit and the pods' offset: the
+    ship turns its pods to the order plus the offset."""
+    from shipgym.models import RVGParams
+    from shipgym.models.model_file import rvg_document
+
+    fitted = replace(RVGParams.named("sea_trials"), azimuth_offset=math.radians(2.0))
+    path = tmp_path / "rvg_fit.json"
+    doc = rvg_document(fitted, current=(0.1, -0.2), sway_offset=0.05, source="trials.csv")
+    path.write_text(json.dumps({"model": "rvg3dof", "rvg3dof": doc}))
+    ship = load_model(path)
+    assert (
+        ship.name == "rvg3dof" and ship.params.pod_lift_coefficient == fitted.pod_lift_coefficient
+    )
+    np.testing.assert_array_equal(ship.params.linear_damping, fitted.linear_damping)
+    assert ship.params.azimuth_offset == math.radians(2.0)
+    plain = make_model("rvg3dof", replace(fitted, azimuth_offset=0.0))
+    x0 = np.zeros(ship.nx)
+    x0[ship.index("u")] = 5.0
+    cmd = np.tile([25e3, 25e3, math.radians(10.0), math.radians(10.0)], (200, 1))
+    shifted = cmd + np.array([0.0, 0.0, math.radians(2.0), math.radians(2.0)])
+    np.testing.assert_array_equal(
+        ship.simulate(x0, cmd, 0.5).states, plain.simulate(x0, shifted, 0.5).states
+    )
+    env = gym.make("shipgym/RVGHeading-v1", params=str(path))
+    assert env.unwrapped.task.model.params.azimuth_offset == math.radians(2.0)
+    with pytest.raises(ValueError, match="azimuth_offset must be within"):
+        replace(fitted, azimuth_offset=0.2)

@@ -627,8 +627,9 @@ def make_model(
     params : dataclass or str, optional
         Parameters of the right type (e.g. :class:`Nomoto1Params`, :class:`MMGParams`);
         defaults otherwise. For ``rvg3dof`` also the name of a shipped set (``"seed001"``,
-        ``"sea_trials"``: :meth:`RVGParams.named`), for ``kvlcc2`` ``"kvlcc2"``; ``vmm`` needs
-        :class:`VMMParams` or the path of a fitted model's JSON (:meth:`VMMParams.load`).
+        ``"sea_trials"``: :meth:`RVGParams.named`) or the model file of its identification,
+        for ``kvlcc2`` ``"kvlcc2"``; ``vmm`` needs :class:`VMMParams` or the path of a fitted
+        model's JSON (:meth:`VMMParams.load`).
     gear, surge : SteeringGear, SurgeModel, optional
         Steering gear and surge model of the Nomoto family.
     input_delay : float
@@ -670,6 +671,14 @@ def make_model(
         return ShipModel(name, params)
     three_dof = {"rvg3dof": RVGParams, "kvlcc2": MMGParams}
     expected = three_dof.get(name) or _DEFAULT_YAW[name]
+    if name == "rvg3dof" and is_model_file(params):  # an identified Gunnerus
+        ship = load_model(params)
+        if ship.name != "rvg3dof":
+            raise ValueError(
+                f"{str(params)!r} holds a {ship.name!r} model; rvg3dof takes a model file of "
+                "shipgym identify --model rvg3dof --json"
+            )
+        params = ship.params
     if isinstance(params, str):
         if name not in three_dof:
             raise ValueError(

@@ -24,6 +24,12 @@ fit.json`` and ``shipgym design fit.json``:
   record's median speed (``speed_m_s``; the default 7.7 m/s without a speed channel). The
   identified current is a property of the record, kept for information and not part of the
   ship.
+* ``"rvg3dof"`` (the R/V Gunnerus 3-DOF model of seed 001; written by :func:`rvg_document`):
+  the :class:`RVGParams` fields of the fit (matrices as nested lists) with its calibrated values
+  and effect terms (pod lift, slipstream, wave resistance, ...) and the identified azimuth offset
+  as ``azimuth_offset`` (the pods turn to the order plus it); the record's current and sway
+  offset (a log or antenna misalignment) are kept for information, ``current_m_s`` and
+  ``sway_offset_m_s``. The RVG envs take it as ``params="fit.json"``.
 * ``"vmm"`` (seed 003's general 3-DOF model, :meth:`VMMParams.load`) and ``"kvlcc2"`` (the MMG
   model with refined derivatives, :class:`MMGParams` fields).
 """
@@ -38,6 +44,8 @@ from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from shipgym.models.base import NOMOTO_MODEL_NAMES, ShipModel, make_model
 from shipgym.models.mmg import MMGParams
 from shipgym.models.nomoto import (
@@ -48,6 +56,7 @@ from shipgym.models.nomoto import (
     SteeringGear,
     SurgeModel,
 )
+from shipgym.models.rvg import RVGParams
 from shipgym.models.vmm import VMMParams
 
 __all__ = [
@@ -56,10 +65,11 @@ __all__ = [
     "load_model",
     "model_info",
     "nomoto_document",
+    "rvg_document",
     "with_rudder_offset",
 ]
 
-MODEL_FILE_KEYS: tuple[str, ...] = ("nomoto", "vmm", "kvlcc2")
+MODEL_FILE_KEYS: tuple[str, ...] = ("nomoto", "rvg3dof", "vmm", "kvlcc2")
 """The family keys of a model file."""
 
 _YAW_PARAMS = {
@@ -126,6 +136,42 @@ def nomoto_document(
         "current_m_s": None if current is None else [float(current[0]), float(current[1])],
         "source": source,
     }
+
+
+def rvg_document(
+    params: RVGParams,
+    *,
+    current: tuple[float, float] = (0.0, 0.0),
+    sway_offset: float = 0.0,
+    source: str = "",
+) -> dict[str, Any]:
+    """The ``"rvg3dof"`` entry of a model file (module docstring)."""
+    doc: dict[str, Any] = {}
+    for f in fields(RVGParams):
+        value = getattr(params, f.name)
+        doc[f.name] = value.tolist() if isinstance(value, np.ndarray) else value
+    doc["pod_x"], doc["pod_y"] = list(params.pod_x), list(params.pod_y)
+    doc.update(
+        current_m_s=[float(current[0]), float(current[1])],
+        sway_offset_m_s=float(sway_offset),
+        source=source,
+    )
+    return doc
+
+
+def _rvg(doc: Mapping[str, Any], where: str) -> ShipModel:
+    names = {f.name for f in fields(RVGParams)}
+    kw = {k: v for k, v in doc.items() if k in names}
+    for key in ("pod_x", "pod_y"):
+        if key in kw:
+            kw[key] = tuple(kw[key])
+    try:
+        params = RVGParams(**kw)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"{where}: its 'rvg3dof' entry is not an RVG parameter set: {exc}"
+        ) from None
+    return make_model("rvg3dof", params)
 
 
 def _surge(speed: float | None) -> SurgeModel:
@@ -224,6 +270,8 @@ def load_model(source: str | os.PathLike[str] | Mapping[str, Any]) -> ShipModel:
     data, where = _read(source)
     if isinstance(data.get("nomoto"), Mapping):
         return _nomoto(data["nomoto"], where)
+    if isinstance(data.get("rvg3dof"), Mapping):
+        return _rvg(data["rvg3dof"], where)
     if isinstance(data.get("vmm"), Mapping):
         vmm = {k: v for k, v in data["vmm"].items() if k != "current"}
         return make_model("vmm", VMMParams.from_dict(vmm))

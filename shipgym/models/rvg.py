@@ -15,7 +15,8 @@ text prints ``m22 u`` in ``C[2,0]``; that breaks skew-symmetry and is a typo, Fo
 Damping (eq. 15): ``D(nu_r) = D_l + D_u |u_r| + D_v |v_r| + D_r |r|``.
 
 Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`` and
-``alpha' = sat_rate((sat(alpha_c) - alpha) / tau_alpha)``; each pod at ``(x_t, y_t)`` gives
+``alpha' = sat_rate((sat(alpha_c) + alpha_0 - alpha) / tau_alpha)`` (``alpha_0``: an identified
+azimuth offset, 0 in seed 001); each pod at ``(x_t, y_t)`` gives
 ``F = T [cos a, sin a, -y_t cos a + x_t sin a]``, so positive azimuth on aft pods turns the ship
 to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
 200 rpm (RVG_PARAMETERS.md).
@@ -232,6 +233,9 @@ class RVGParams:
         ``c_w`` [-] of the wave-making resistance ``R_w = c_w Fn^2 rho/2 S u_r^2`` with
         ``Fn = u_r / sqrt(g L)`` (0 in seed 001): the resistance that rises faster than ``u^2``
         from Froude number 0.2 on (the trials run at 0.20-0.34).
+    azimuth_offset : float
+        ``alpha_0`` [rad]: the pods' real azimuth is the order plus this (a misaligned pod zero,
+        the identification's ``azimuth_offset`` effect; 0 in seed 001), within +-5 deg.
     name : str
         Name of the parameter set (``"seed001"``; :meth:`sea_trials` gives ``"sea_trials"``).
     """
@@ -270,6 +274,7 @@ class RVGParams:
     surge_rr: float = 0.0
     crossflow_coefficient: float = 0.0
     wave_resistance: float = 0.0
+    azimuth_offset: float = 0.0
     name: str = "seed001"
 
     def __post_init__(self) -> None:
@@ -314,6 +319,11 @@ class RVGParams:
         for name in ("surge_vv", "surge_vr", "surge_rr"):
             if not math.isfinite(getattr(self, name)):
                 raise ValueError(f"RVGParams.{name} must be finite, got {getattr(self, name)!r}")
+        if not (math.isfinite(self.azimuth_offset) and abs(self.azimuth_offset) <= math.radians(5)):
+            raise ValueError(
+                f"RVGParams.azimuth_offset must be within +-5 deg (+-0.0873 rad), got "
+                f"{self.azimuth_offset!r}"
+            )
 
     @classmethod
     def sea_trials(cls) -> RVGParams:
@@ -403,7 +413,8 @@ P_XVV, P_XVR, P_XRR, P_CF = 52, 53, 54, 55  # surge terms; rho/2 T C_cf
 P_XW = 56  # rho S c_w / (2 g L) of the wave-making resistance
 P_CF_X = 57  # 12 Gauss-Legendre stations x [m] along the hull
 P_CF_W = P_CF_X + _GL_X.size  # and their weights [m]
-P_SIZE = P_CF_W + _GL_X.size
+P_AOFF = P_CF_W + _GL_X.size  # azimuth offset alpha_0 [rad]
+P_SIZE = P_AOFF + 1
 
 
 def pack_rvg(params: RVGParams) -> np.ndarray:
@@ -443,6 +454,7 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_CF] = 0.5 * WATER_DENSITY * DRAUGHT * params.crossflow_coefficient
     p[P_CF_X : P_CF_X + _GL_X.size] = (LPP - CG_FORWARD_OF_AP - half) + half * _GL_X
     p[P_CF_W : P_CF_W + _GL_X.size] = half * _GL_W
+    p[P_AOFF] = params.azimuth_offset
     return p
 
 
@@ -564,8 +576,9 @@ def rvg_col(X, U, p, C, K, b):
     inv_tau_a = p[P_INV_TAU_A]
     dt1 = (min(max(U[0, b], 0.0), tmax) - th1) * inv_tau_t
     dt2 = (min(max(U[1, b], 0.0), tmax) - th2) * inv_tau_t
-    da1 = min(max((min(max(U[2, b], -amax), amax) - X[IA1, b]) * inv_tau_a, -rate), rate)
-    da2 = min(max((min(max(U[3, b], -amax), amax) - X[IA2, b]) * inv_tau_a, -rate), rate)
+    aoff = p[P_AOFF]  # the pods turn to the order plus their offset
+    da1 = min(max((min(max(U[2, b], -amax), amax) + aoff - X[IA1, b]) * inv_tau_a, -rate), rate)
+    da2 = min(max((min(max(U[3, b], -amax), amax) + aoff - X[IA2, b]) * inv_tau_a, -rate), rate)
     # every write after every read (the loop over the ships then compiles to SIMD code)
     K[IX, b] = cs * uu - sn * vv  # eq. (6)
     K[IY, b] = sn * uu + cs * vv

@@ -100,6 +100,7 @@ from scipy.signal import savgol_filter
 from shipgym.models import RVGParams
 from shipgym.models._jit import kernel
 from shipgym.models.integrate import RVG3DOF, rk4_block
+from shipgym.models.model_file import rvg_document
 from shipgym.models.rvg import (
     DRAUGHT,
     IA1,
@@ -949,6 +950,14 @@ class RVGFamily(ModelFamily):
             "error_after": errors(rec, _channels(sim_after), every_idx),
             "heldout": heldout,
             "traces": traces,
+            "model_file": {
+                "rvg3dof": rvg_document(
+                    replace(final_full.params, azimuth_offset=final_full.alpha_0),
+                    current=final_full.current,
+                    sway_offset=final_full.v_0,
+                    source=str(rec.meta.get("file") or rec.meta.get("source") or ""),
+                )
+            },
             "effect_parameters": {
                 e: self.effect_parameters(final_full, e) for e in final_full.effects
             },
