@@ -63,7 +63,11 @@ class NomotoHeadingEnv(ShipEnv):
     ## Arguments
 
     ``gymnasium.make("shipgym/NomotoHeading-v0", model="nomoto1", max_current_speed=1.0,
-    setpoint_interval=200.0, render_mode=None)``. ``reset(options=...)`` accepts
+    setpoint_interval=200.0, render_mode=None)``. ``model`` is a model name, an identified
+    ship's model file (``shipgym identify --json FIT.json``), an identification result or a
+    Nomoto-family ``ShipModel``; an identified ship brings its steering gear, speed, rudder
+    offset and input delay (the rudder command reaches the ship late; the reward's action term
+    is that of the command applied). ``reset(options=...)`` accepts
     ``current_speed`` [m/s], ``current_direction`` [rad, toward, clockwise from north],
     ``initial_state`` (dict of named states or a full state vector) and ``setpoints`` (1 to 8
     headings [rad], each held ``setpoint_interval`` seconds, the last held to the end).

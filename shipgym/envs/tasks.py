@@ -625,7 +625,8 @@ def nomoto_ship(model: Any) -> ShipModel:
     if ship.name not in NOMOTO_MODEL_NAMES:
         raise ValueError(
             f"model {ship.name!r} ({model!r}) is not of the Nomoto family {NOMOTO_MODEL_NAMES} "
-            "that this env steers (a 3-DOF fit runs in shipgym simulate)"
+            "that this env steers (an rvg3dof fit sails the Gunnerus envs as params=FILE, the "
+            "other 3-DOF fits run in shipgym simulate)"
         )
     return ship
 
