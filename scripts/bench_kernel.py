@@ -97,8 +97,11 @@ def _reference_step(X, U, C, q, h):  # pragma: no cover - jit
         k2 = _deriv(_axpy(s0, 0.5 * h, k1), u, cn, ce, q)
         k3 = _deriv(_axpy(s0, 0.5 * h, k2), u, cn, ce, q)
         k4 = _deriv(_axpy(s0, h, k3), u, cn, ce, q)
-        for j in range(10):
-            X[j, i] = s0[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+        # k1 + 2 k2 + 2 k3 + k4, then the step; written as tuples (a loop over a tuple's
+        # entries indexes it at run time, which keeps the values in memory and the loop scalar)
+        ks = _axpy(_axpy(_axpy(k1, 2.0, k2), 2.0, k3), 1.0, k4)
+        (X[0, i], X[1, i], X[2, i], X[3, i], X[4, i], X[5, i], X[6, i], X[7, i], X[8, i],
+         X[9, i]) = _axpy(s0, h / 6.0, ks)  # fmt: skip
 
 
 def _constants(p: np.ndarray) -> tuple:

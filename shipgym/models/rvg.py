@@ -604,11 +604,13 @@ def _pod_normal(up, vp, sa, ca, thrust, slip, stall):
     """
     vv2 = up * up + vp * vp
     q = vv2 + slip * max(thrust, 0.0)
-    vabs = math.sqrt(vv2)
+    # angle of attack alpha - beta_p = atan2(sin, cos) of the difference; atan2 is the same
+    # for any positive scale of its arguments, so the inflow (up, vp) enters unnormalised (no
+    # square root, no division); without inflow beta_p = 0
     moving = vv2 > 0.0
-    cb = up / vabs if moving else 1.0
-    sb = vp / vabs if moving else 0.0
-    # angle of attack alpha - beta_p, wrapped to [-pi, pi], then stalled
+    cb = up if moving else 1.0
+    sb = vp if moving else 0.0
+    # wrapped to [-pi, pi], then stalled
     aoa = atan2(sa * cb - ca * sb, ca * cb + sa * sb)
     aoa = (
         aoa - math.pi if aoa > math.pi - stall else aoa + math.pi if aoa < stall - math.pi else aoa
