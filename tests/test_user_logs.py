@@ -117,6 +117,38 @@ def test_delimiters_and_decimal_comma(
     assert ("decimal comma read as a decimal point" in rec.meta["conversions"]) == (decimal == ",")
 
 
+@pytest.mark.parametrize("sep", [",", ";"])
+def test_quoted_fields_with_a_decimal_comma(
+    truth: Record, csv_record: Record, tmp_path: Path, sep: str
+) -> None:
+    """A spreadsheet's export: every field in double quotes, decimal commas inside them (with a
+    comma as the delimiter too)."""
+    rows = _table(truth, ";", ",").splitlines()
+    quoted = [rows[0]] + [sep.join(f'"{f}"' for f in row.split(";")) for row in rows[1:]]
+    path = tmp_path / "export.csv"
+    path.write_text("\n".join(quoted) + "\n")
+    rec = load(path, columns=COLUMNS)
+    for name in ("time", "delta", "psi", "r", "U"):
+        np.testing.assert_array_equal(getattr(rec, name), getattr(csv_record, name))
+    assert "decimal comma read as a decimal point" in rec.meta["conversions"]
+
+
+def test_unit_suffixes_spelled_per_and_columns_not_read(truth: Record, tmp_path: Path) -> None:
+    """``rot_deg_per_min`` is the yaw rate in deg/min; a column no channel takes is named."""
+    header = "t_s,rudder_deg,heading_deg,rot_deg_per_min,engine_temp"
+    lines = [header] + [
+        f"{float(truth.time[k])!r},{math.degrees(truth.delta[k])!r},"
+        f"{math.degrees(truth.psi[k])!r},{math.degrees(truth.r[k]) * 60.0!r},80"
+        for k in range(truth.n)
+    ]
+    path = tmp_path / "per.csv"
+    path.write_text("\n".join(lines) + "\n")
+    rec = load(path)
+    np.testing.assert_allclose(rec.r, truth.r, rtol=1e-12, atol=1e-15)
+    assert "r = rot_deg_per_min [deg/min]" in rec.meta["conversions"]
+    assert "column(s) ['engine_temp'] not read (no channel of a record)" in rec.meta["notes"]
+
+
 def test_headers_that_state_their_units_need_no_column_map(tmp_path: Path) -> None:
     t = np.arange(200) * 0.5
     psi = np.radians(10.0) * np.sin(t / 20.0)
@@ -285,6 +317,25 @@ def _bad_files(tmp: Path) -> Iterator[tuple[str, list[str], list[str]]]:
         [str(no_heading)],
         ["no heading sentence (HDT, THS or HDG) in 80 sentences", "expected a heading"],
     )
+    text = good.replace("\n5,2,5\n", "\n5,1e300,5\n").replace("\n6,0,6\n", "\n6,1e300,6\n")
+    yield (
+        "a rudder beyond any angle in the unit the column map states",
+        [str(_write(tmp, "g.csv", text)), "--columns", cmap],
+        ["'rudder' reaches", "deg as stated in the column map, so not a unit mix-up"],
+    )
+    lines = write_nmea(
+        tmp / "h.nmea",
+        start=datetime.datetime(2026, 6, 1, 12, tzinfo=datetime.UTC),
+        time=t, psi=0.01 * t, delta=np.zeros(40), U=np.full(40, 3.0), x=3.0 * t, y=0 * t,
+        rates={"RMC": 1.0, "HDT": 1.0},
+    ).read_text().splitlines()  # fmt: skip
+    # every time-stamped sentence corrupted (its checksum no longer fits)
+    spoilt = [ln.replace("RMC,12", "RMC,13") for ln in lines]
+    yield (
+        "an NMEA log whose time sentences all fail their checksum",
+        [str(_write(tmp, "h.nmea", "\n".join(spoilt) + "\n"))],
+        ["found HDT 40, RMC 40 (of them dropped: 40 for a bad checksum)"],
+    )
     yield (
         "fewer than two samples",
         [str(_write(tmp, "e.csv", "t,rudder,hdg\n0,1,2\n")), "--columns", cmap],
@@ -301,6 +352,7 @@ def test_bad_files_end_with_one_line_and_exit_code_2(
         lines = [ln for ln in err.splitlines() if ln.startswith("shipgym")]
         assert code == 2, case
         assert len(lines) == 1 and "Traceback" not in err, (case, err)
+        assert len(lines[0]) < 600, (case, lines[0])  # no number printed in 300 digits
         for needle in needles:
             assert needle in lines[0], (case, needle, lines[0])
 

@@ -925,13 +925,16 @@ def _check_units(
     x: np.ndarray | None = None,
     y: np.ndarray | None = None,
     speed_is_derived: bool = False,
+    declared: Mapping[str, str] | None = None,
 ) -> None:
     """Refuse clear unit errors and warn about borderline ones (see the module docstring).
 
     ``psi_raw`` is the heading as read (radians by the format, not yet unwrapped); ``r`` the
     yaw rate as read (None when the source has none); ``U`` the speed (derived from ``x, y``
     when ``speed_is_derived``). ``names`` maps ``time, psi, r, delta, U`` to the source's
-    column names for the messages.
+    column names for the messages; ``declared`` the channels whose unit the user stated (a
+    column map) to that unit: an impossible value there is no unit mix-up, and the message
+    says so rather than suggest a conversion.
     """
     col = {"time": "time", "psi": "psi", "r": "r", "delta": "delta", "U": "U", **(names or {})}
     label = {k: f"column {v!r}" for k, v in col.items()}
@@ -958,12 +961,25 @@ def _check_units(
             "radians (convert with numpy.radians)"
         )
     # rudder and yaw-rate magnitudes (robust to single spikes: 99.9th percentile)
+    declared = dict(declared or {})
+
+    def stated(channel: str) -> str:
+        """The end of a refusal for a channel whose unit the user stated."""
+        return (
+            f"in {declared[channel]} as stated in the column map, so not a unit mix-up: is it "
+            "the right column?"
+        )
+
     big_delta = float(np.percentile(np.abs(delta), 99.9))
     if big_delta > _MAX_RUDDER:
         raise refuse(
-            f"{label['delta']} reaches {big_delta:.4g} rad ({math.degrees(big_delta):.0f} deg), "
-            f"beyond any rudder angle: it looks like degrees; expected radians (convert with "
-            "numpy.radians)"
+            f"{label['delta']} reaches {big_delta:.4g} rad ({math.degrees(big_delta):.4g} deg), "
+            + (
+                f"beyond any rudder angle, {stated('delta')}"
+                if "delta" in declared
+                else "beyond any rudder angle: it looks like degrees; expected radians (convert "
+                "with numpy.radians)"
+            )
         )
     if big_delta > _WARN_RUDDER:
         warn(
@@ -981,13 +997,18 @@ def _check_units(
         if big_r > _MAX_YAW_RATE:
             agrees = math.isfinite(ratio) and abs(corr) > 0.9 and abs(math.log(ratio)) < 0.2
             raise refuse(
-                f"{label['r']} reaches {big_r:.4g} rad/s ({math.degrees(big_r):.0f} deg/s), "
-                f"faster than any ship turns (limit {_MAX_YAW_RATE:g} rad/s): it looks like "
+                f"{label['r']} reaches {big_r:.4g} rad/s ({math.degrees(big_r):.4g} deg/s), "
+                f"faster than any ship turns (limit {_MAX_YAW_RATE:g} rad/s)"
                 + (
-                    f"deg/s, and {label['psi']}, which agrees with it, like degrees; expected "
-                    "rad/s and radians"
-                    if agrees
-                    else "deg/s; expected rad/s"
+                    f", {stated('r')}"
+                    if "r" in declared
+                    else ": it looks like "
+                    + (
+                        f"deg/s, and {label['psi']}, which agrees with it, like degrees; "
+                        "expected rad/s and radians"
+                        if agrees
+                        else "deg/s; expected rad/s"
+                    )
                 )
             )
         if big_r > _WARN_YAW_RATE:

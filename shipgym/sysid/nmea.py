@@ -473,6 +473,17 @@ def _counts_text(counts: Mapping[str, int]) -> str:
     return ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])))
 
 
+def _found_text(scan: _Scan) -> str:
+    """The sentences of a log by type, and those of them dropped as unusable (for errors)."""
+    dropped = []
+    if scan.bad_checksum:
+        dropped.append(f"{len(scan.bad_checksum)} for a bad checksum")
+    if scan.unparseable:
+        dropped.append(f"{len(scan.unparseable)} unreadable")
+    text = _counts_text(scan.counts)
+    return f"{text} (of them dropped: {', '.join(dropped)})" if dropped else text
+
+
 def _spread(
     anchor: np.ndarray, own: np.ndarray, source_code: np.ndarray
 ) -> tuple[np.ndarray, int, np.ndarray]:
@@ -569,10 +580,10 @@ def _timing(scan: _Scan, name: str) -> _Timing:
             )
     else:
         if n_timed == 0:
-            counts = _counts_text(scan.counts)
             raise ValueError(
                 f"{name}: no time in {scan.n_sentences} sentences: no logger time stamps and no "
-                f"time-stamped sentence (RMC, GGA, GLL, ZDA); found {counts}; expected one of them"
+                f"usable time-stamped sentence (RMC, GGA, GLL, ZDA); found {_found_text(scan)}; "
+                "expected one of them"
             )
         absolute = np.full(n, math.nan)
         prev: float | None = None
@@ -827,7 +838,7 @@ def _heading(chans: _Channels, scan: _Scan, name: str, meta: dict[str, Any]) -> 
     else:
         raise ValueError(
             f"{name}: no valid heading in {scan.n_sentences} sentences (every HDT, THS and HDG "
-            f"is marked invalid or cannot be timed); found {_counts_text(scan.counts)}; "
+            f"is marked invalid or cannot be timed); found {_found_text(scan)}; "
             "expected a heading to identify a model"
         )
     heading = _series(src, t, h_deg, True, notes)
@@ -1043,7 +1054,7 @@ def load_nmea(
     if not any(m in scan.counts for m in ("HDT", "THS", "HDG")):
         raise ValueError(
             f"{name}: no heading sentence (HDT, THS or HDG) in {scan.n_sentences} sentences; "
-            f"found {_counts_text(scan.counts)}; expected a heading to identify a model"
+            f"found {_found_text(scan)}; expected a heading to identify a model"
         )
     timing = _timing(scan, name)
     meta["conversions"] += timing.conversions

@@ -46,8 +46,9 @@ built from the file's header.
 Text
 ----
 Delimiter ``,``, ``;``, tab or runs of blanks (the one that splits the header into the most
-fields); a decimal comma (``12,5`` with ``;``, tab or blanks between fields); comment lines
-starting with ``#``, ``%`` or ``//`` anywhere; a UTF-8 byte-order mark.
+fields); fields in double quotes (which may hold the delimiter); a decimal comma (``12,5`` with
+``;``, tab or blanks between fields, or ``"12,5"`` quoted with any); comment lines starting
+with ``#``, ``%`` or ``//`` anywhere; a UTF-8 byte-order mark.
 
 Gaps and segments
 -----------------
@@ -68,6 +69,7 @@ heading unwrapped and repaired, yaw rate derived from the heading when absent (l
 
 from __future__ import annotations
 
+import csv
 import itertools
 import math
 import re
@@ -179,6 +181,13 @@ _UNIT_SPELLINGS: dict[str, str] = {
     "dps": "deg/s",
     "deg/min": "deg/min",
     "deg_min": "deg/min",
+    "deg_per_s": "deg/s",
+    "deg_per_sec": "deg/s",
+    "deg_per_min": "deg/min",
+    "rad_per_s": "rad/s",
+    "rad_per_sec": "rad/s",
+    "m_per_s": "m/s",
+    "rev_per_s": "rev/s",
     "°/min": "deg/min",
     "m/s": "m/s",
     "m_s": "m/s",
@@ -384,12 +393,22 @@ def _is_comment(line: str) -> bool:
     return not s or s.startswith(_COMMENT)
 
 
+def _split(line: str, sep: str | None) -> list[str]:
+    """The fields of a line (``sep`` None: runs of blanks); a field in double quotes may hold
+    the delimiter (``"12,5"`` in a comma-separated export with a decimal comma)."""
+    if sep is None:
+        return line.split()
+    if '"' not in line:
+        return line.split(sep)
+    return next(csv.reader([line], delimiter=sep))
+
+
 def _sniff(header: str, sample: str) -> str | None:
     """The delimiter (None: runs of blanks) that splits the header and a data row alike."""
     best: tuple[int, str | None] = (1, None)
     for sep in (",", ";", "\t"):
-        n = len(header.split(sep))
-        if n > best[0] and len(sample.split(sep)) == n:
+        n = len(_split(header, sep))
+        if n > best[0] and len(_split(sample, sep)) == n:
             best = (n, sep)
     if best[1] is None and len(header.split()) == len(sample.split()) > 1:
         return None
@@ -490,7 +509,7 @@ def load_table(
             f"{path.name} line {header_line}: cannot split the header {header[:80]!r} and the "
             "first data row into the same fields with ',', ';', tab or blanks"
         ) from None
-    cols = [c.strip().strip('"') for c in (header.split(sep) if sep else header.split())]
+    cols = [c.strip().strip('"') for c in _split(header, sep)]
     seen: dict[str, int] = {}
     for j, c in enumerate(cols):
         if c in seen:
@@ -518,12 +537,10 @@ def load_table(
     say(f"{path.name}: {len(rows) - 1} rows, delimiter {sep or 'blanks'!r}")
     ncol = len(cols)
     fields: list[list[str]] = []
-    decimal_comma = sep != "," and any(
-        _DECIMAL_COMMA.match(f.strip())
-        for f in (rows[1][1].split(sep) if sep else rows[1][1].split())
-    )
+    # a decimal comma: unquoted between other delimiters, or quoted ("12,5") with any
+    decimal_comma = any(_DECIMAL_COMMA.match(f.strip().strip('"')) for f in _split(rows[1][1], sep))
     for line_no, line in rows[1:]:
-        parts = line.split(sep) if sep else line.split()
+        parts = _split(line, sep)
         if len(parts) != ncol:
             raise ValueError(
                 f"{path.name} line {line_no}: expected {ncol} fields like the header, got "
@@ -539,6 +556,10 @@ def load_table(
             + ",".join(f"{ch}={col}:{next(iter(UNITS[ch]))}" for ch, col in skipped.items())
             + ")",
         )
+    used = {col for col, _, _ in mapping.values()} | set(skipped.values())
+    unused = [c for c in cols if c not in used]
+    if unused:
+        meta["notes"].append(f"column(s) {unused} not read (no channel of a record)")
     if decimal_comma:
         meta["conversions"].append("decimal comma read as a decimal point")
     arrays: dict[str, Any] = {}
@@ -558,7 +579,8 @@ def load_table(
         else:
             arrays[channel] = -_numbers(values, where) if negate else _numbers(values, where)
             units[channel] = unit
-        text = f"{channel} = {'-' if negate else ''}{col} [{unit}]"
+        stated = _BRACKET.match(col) is not None  # "rudder [deg]" names its unit already
+        text = f"{channel} = {'-' if negate else ''}{col}" + ("" if stated else f" [{unit}]")
         meta["conversions"].append(text)
     names = {ch: col for ch, (col, _, _) in mapping.items()}
     return record_from_arrays(
@@ -738,6 +760,7 @@ def record_from_arrays(
             U=part("U"),
             x=part("x"),
             y=part("y"),
+            declared=units,
         )
     psi_parts, r_parts = [], []
     prev_end: float | None = None
