@@ -366,13 +366,44 @@ def _pod_lift_force(params: RVGParams, x: np.ndarray) -> np.ndarray:
         up, vp = u - yt * r, v + xt * r
         beta = math.atan2(vp, up)
         aoa = (x[8 + k] - beta + math.pi) % (2 * math.pi) - math.pi
-        aoa = float(np.clip(aoa, -params.pod_stall_angle, params.pod_stall_angle))
+        stall = params.pod_stall_angle
+        if aoa > math.pi - stall:  # flow from astern: the foil's angle turned by pi
+            aoa -= math.pi
+        elif aoa < stall - math.pi:
+            aoa += math.pi
+        aoa = float(np.clip(aoa, -stall, stall))
         slip = 8 * x[6 + k] / (WATER_DENSITY * math.pi * params.propeller_diameter**2)
         lift = params.pod_lift_coefficient * (up**2 + vp**2 + params.pod_slipstream * slip)
         lift *= math.sin(aoa)
         fx, fy = -lift * math.sin(x[8 + k]), lift * math.cos(x[8 + k])
         force += np.array([fx, fy, xt * fy - yt * fx])
     return force
+
+
+def test_rvg_pod_lift_in_every_inflow_direction_stall_and_flow_from_astern() -> None:
+    """The pod normal force for inflows from every direction and any azimuth, astern and beyond
+    the stall angle included, against the angles formed explicitly (atan2, wrap, turn by pi,
+    clip); also for a ship at rest with its pods thrusting (no inflow, the slipstream only)."""
+    base = make_model("rvg3dof", RVGParams())
+    for stall in (math.radians(30.0), 1.2):
+        lift = make_model(
+            "rvg3dof",
+            RVGParams(pod_lift_coefficient=6.5e3, pod_slipstream=0.5, pod_stall_angle=stall),
+        )
+        params = lift.params
+        rng = np.random.default_rng(11)
+        for k in range(300):
+            u, v = rng.uniform(-4, 4, 2) if k % 10 else (0.0, 0.0)
+            r = rng.uniform(-0.1, 0.1) if k % 10 else 0.0
+            alpha = rng.uniform(-math.pi, math.pi, 2)
+            thrust = rng.uniform(0, 60e3, 2)
+            x = np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha])
+            inputs = [*thrust, *alpha]
+            diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
+            expected = _pod_lift_force(params, x)
+            np.testing.assert_allclose(params.mass_matrix @ diff, expected, rtol=1e-9, atol=1e-6)
+    with pytest.raises(ValueError, match=r"pod_stall_angle must be an angle in \(0, pi/2\)"):
+        RVGParams(pod_stall_angle=math.radians(95.0))
 
 
 def test_rvg_pod_lift_adds_the_foil_force_from_each_pods_inflow() -> None:

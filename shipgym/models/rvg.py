@@ -85,7 +85,7 @@ import numpy as np
 
 from shipgym.models._jit import row_kernel, simd_kernel
 from shipgym.models.kinematics import body_current
-from shipgym.models.vmath import atan2, sincos
+from shipgym.models.vmath import sincos
 
 RVG_PARAMETER_SETS = ("seed001", "sea_trials")
 """Names of the shipped parameter sets (:meth:`RVGParams.named`)."""
@@ -308,10 +308,16 @@ class RVGParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"RVGParams.{name} must be a finite number >= 0, got {value!r}")
-        for name in ("pod_stall_angle", "propeller_diameter"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"RVGParams.{name} must be a finite number > 0, got {value!r}")
+        value = self.propeller_diameter
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(
+                f"RVGParams.propeller_diameter must be a finite number > 0, got {value!r}"
+            )
+        value = self.pod_stall_angle
+        if not (math.isfinite(value) and 0.0 < value < 0.5 * math.pi):
+            raise ValueError(
+                f"RVGParams.pod_stall_angle must be an angle in (0, pi/2) rad, got {value!r}"
+            )
         for name in ("thrust_deduction", "wake_fraction"):
             value = getattr(self, name)
             if not (math.isfinite(value) and 0.0 <= value < 1.0):
@@ -408,7 +414,7 @@ P_INV_TAU_T, P_INV_TAU_A, P_ARATE, P_AMAX, P_TBOLL, P_INV_U0 = (
     45,
 )  # 1/x saves divisions
 P_LIFT, P_INV_NREF = 46, 47
-P_STALL, P_SLIP, P_HULL_T, P_ADV = 48, 49, 50, 51  # stall angle, k_s 8/(rho pi D^2), 1-t, 1-w
+P_SIN_STALL, P_SLIP, P_HULL_T, P_ADV = 48, 49, 50, 51  # sin(stall), k_s 8/(rho pi D^2), 1-t, 1-w
 P_XVV, P_XVR, P_XRR, P_CF = 52, 53, 54, 55  # surge terms; rho/2 T C_cf
 P_XW = 56  # rho S c_w / (2 g L) of the wave-making resistance
 P_CF_X = 57  # 12 Gauss-Legendre stations x [m] along the hull
@@ -442,7 +448,7 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_INV_U0] = 1.0 / params.thrust_zero_speed
     p[P_LIFT] = params.pod_lift_coefficient
     p[P_INV_NREF] = 1.0 / params.reference_rpm
-    p[P_STALL] = params.pod_stall_angle
+    p[P_SIN_STALL] = math.sin(params.pod_stall_angle)
     p[P_SLIP] = (
         params.pod_slipstream * 8.0 / (WATER_DENSITY * math.pi * params.propeller_diameter**2)
     )
@@ -530,9 +536,9 @@ def rvg_col(X, U, p, C, K, b):
     fy = t1 * sa1 + t2 * sa2
     fn = t1 * (-y1 * ca1 + x1 * sa1) + t2 * (-y2 * ca2 + x2 * sa2)
     # pod foil normal force from each pod's own inflow (module docstring; zero in seed 001)
-    lift, slip, stall = p[P_LIFT], p[P_SLIP], p[P_STALL]
-    n1 = lift * _pod_normal(ur - y1 * r, vr + x1 * r, sa1, ca1, th1, slip, stall)
-    n2 = lift * _pod_normal(ur - y2 * r, vr + x2 * r, sa2, ca2, th2, slip, stall)
+    lift, slip, sin_stall = p[P_LIFT], p[P_SLIP], p[P_SIN_STALL]
+    n1 = lift * _pod_normal(ur - y1 * r, vr + x1 * r, sa1, ca1, th1, slip, sin_stall)
+    n2 = lift * _pod_normal(ur - y2 * r, vr + x2 * r, sa2, ca2, th2, slip, sin_stall)
     fx -= n1 * sa1 + n2 * sa2
     fy += n1 * ca1 + n2 * ca2
     fn += n1 * (x1 * ca1 + y1 * sa1) + n2 * (x2 * ca2 + y2 * sa2)
@@ -593,29 +599,31 @@ def rvg_col(X, U, p, C, K, b):
 
 
 @row_kernel
-def _pod_normal(up, vp, sa, ca, thrust, slip, stall):
+def _pod_normal(up, vp, sa, ca, thrust, slip, sin_stall):
     """Foil normal force per unit lift coefficient of a pod at azimuth ``alpha`` (``sa``, ``ca``)
     in the inflow ``(up, vp)`` [m/s] at the pod, with its slipstream at ``thrust`` (``slip`` the
-    slipstream factor ``k_s``, ``stall`` the stall angle [rad]).
+    slipstream factor ``k_s``, ``sin_stall`` the sine of the stall angle, which is below 90 deg).
 
     ``q sin(clip(alpha - beta_p, +-stall))`` with ``q = |v_p|^2 + k_s max(T, 0)`` and the
     inflow angle ``beta_p``; a flow from astern turns the foil's angle by pi (module
-    docstring). Zero without inflow. Straight-line code (selects), for SIMD.
+    docstring). Zero without inflow.
+
+    No angle is formed: the sine ``s`` and cosine ``c`` of ``alpha - beta_p`` follow from the
+    inflow direction, and for a stall angle below 90 deg the stalled, turned sine is ``s`` (flow
+    from ahead, ``c >= 0``) or ``-s`` (from astern, the angle turned by pi) while
+    ``|s| < sin(stall)``, and ``sin(stall)`` with the sign of ``s`` beyond. Straight-line code
+    (one square root, one division, selects), for SIMD.
     """
     vv2 = up * up + vp * vp
     q = vv2 + slip * max(thrust, 0.0)
-    # angle of attack alpha - beta_p = atan2(sin, cos) of the difference; atan2 is the same
-    # for any positive scale of its arguments, so the inflow (up, vp) enters unnormalised (no
-    # square root, no division); without inflow beta_p = 0
-    moving = vv2 > 0.0
-    cb = up if moving else 1.0
-    sb = vp if moving else 0.0
-    # wrapped to [-pi, pi], then stalled
-    aoa = atan2(sa * cb - ca * sb, ca * cb + sa * sb)
-    aoa = (
-        aoa - math.pi if aoa > math.pi - stall else aoa + math.pi if aoa < stall - math.pi else aoa
-    )
-    s_aoa = sincos(min(max(aoa, -stall), stall))[0]
+    moving = vv2 > 0.0  # without inflow beta_p = 0
+    inv = 1.0 / math.sqrt(vv2) if moving else 1.0
+    cb = up * inv if moving else 1.0
+    sb = vp * inv if moving else 0.0
+    s = sa * cb - ca * sb  # sin(alpha - beta_p)
+    c = ca * cb + sa * sb  # cos(alpha - beta_p)
+    turned = s if c >= 0.0 else -s
+    s_aoa = turned if abs(s) < sin_stall else math.copysign(sin_stall, s)
     return q * s_aoa if q > 0.0 else 0.0
 
 
