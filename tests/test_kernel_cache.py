@@ -82,3 +82,36 @@ def test_the_warm_up_fills_the_cache_that_later_processes_load(tmp_path: Path) -
     later = run("-c", _SIMULATE)
     assert later.returncode == 0, later.stderr
     assert later.stdout.split() == ["1", "0"]
+
+
+_TARGET = (
+    "import llvmlite.binding as llvm, numba\n"
+    "import shipgym.models._jit\n"
+    "host = llvm.get_host_cpu_features().flatten().split(',')\n"
+    "print('+avx512f' in host, numba.config.CPU_NAME, numba.config.CPU_FEATURES)\n"
+)
+
+
+def test_wide_vectors_on_avx512_and_the_users_cpu_settings_stand() -> None:
+    """On an AVX-512 host the kernels compile for the host CPU without LLVM's 256-bit preference
+    (elsewhere nothing is set); a ``NUMBA_CPU_NAME`` or ``NUMBA_CPU_FEATURES`` of the user's is
+    never overridden."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU")}
+    run = subprocess.run(
+        [sys.executable, "-c", _TARGET], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert run.returncode == 0, run.stderr
+    avx512, name, features = run.stdout.split(maxsplit=2)
+    if avx512 == "True":
+        assert name != "None" and features.strip().endswith(",-prefer-256-bit")
+    else:
+        assert (name, features.strip()) == ("None", "None")
+    generic = subprocess.run(
+        [sys.executable, "-c", _TARGET],
+        env={**env, "NUMBA_CPU_NAME": "generic"},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert generic.returncode == 0, generic.stderr
+    assert generic.stdout.split()[1:] == ["generic"]  # and no features: Numba's generic CPU
