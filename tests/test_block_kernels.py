@@ -147,3 +147,23 @@ def test_derivative_and_step_do_not_depend_on_the_batch(name: str) -> None:
         assert np.array_equal(
             model.step(x[i : i + 1], u[i : i + 1], 0.2, c[i : i + 1]), batch_x[[i]]
         )
+
+
+@pytest.mark.parametrize("env_id", ["RVGSpeed-v1", "RVGPathFollowing-v1", "RVGTargetTracking-v1"])
+def test_the_gunnerus_task_kernels_refuse_another_ship(env_id: str) -> None:
+    """The speed, path and target kernels compile the R/V Gunnerus alone: a Nomoto model id is
+    refused with an error, not stepped as if it were the Gunnerus."""
+    import gymnasium as gym
+
+    from shipgym.envs import kernels
+    from shipgym.models.integrate import NOMOTO1
+
+    env = gym.make(f"shipgym/{env_id}")
+    env.reset(seed=0)
+    task = env.unwrapped.task
+    args = list(task._args(True, np.arange(1)))
+    args[2] = NOMOTO1
+    before = task.x.copy()
+    with pytest.raises(ValueError, match="sail the R/V Gunnerus"):
+        kernels.KERNELS[task.kernel_name](*args)
+    np.testing.assert_array_equal(task.x, before)
