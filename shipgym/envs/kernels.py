@@ -39,6 +39,7 @@ from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
 from shipgym.models.integrate import BLOCK, RVG3DOF, block_work, rk4_rows
 from shipgym.models.rvg import P_TBOLL
+from shipgym.models.vmath import sincos
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
 #: Batches at least this large are split over the threads of :func:`run_threaded`.
@@ -355,9 +356,11 @@ def _path(
                 leg_length[i, k],
             )
             progress = s_before[b] - s_left
-            dist_end = math.hypot(x[i, 0] - tangent[i, k + 1, 0], x[i, 1] - tangent[i, k + 1, 1])
+            # within the acceptance radius of the leg's end, compared squared (no hypot call)
+            dn_end = x[i, 0] - tangent[i, k + 1, 0]
+            de_end = x[i, 1] - tangent[i, k + 1, 1]
             bonus = 0.0
-            if dist_end < accept_radius or s_left < 0.0:
+            if dn_end * dn_end + de_end * de_end < accept_radius * accept_radius or s_left < 0.0:
                 if k + 2 < n_wp[i]:
                     k += 1
                     seg[i] = k
@@ -452,9 +455,7 @@ def _target(
             if not ok[b]:
                 continue
             i = rows[start + b]
-            psi = x[i, 2]
-            cs = math.cos(psi)
-            sn = math.sin(psi)
+            sn, cs = sincos(x[i, 2])
             dn = target[i, 0] - x[i, 0]
             de = target[i, 1] - x[i, 1]
             vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
