@@ -444,7 +444,7 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         ax.set_ylim(0, 1.18 * top)
         for bar, v in zip(bars, values, strict=True):
             label = f"{v:.3f}" if v < 1 else f"{v:.2f}"
-            inside = v > 0.12 * top  # value inside the bar top; tiny bars get it above
+            inside = v > 0.25 * top  # value inside the bar top; short bars get it above
             ax.annotate(
                 label,
                 xy=(bar.get_x() + bar.get_width() / 2, v),
