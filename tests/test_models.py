@@ -23,6 +23,7 @@ from shipgym.models import (
     Nomoto2Params,
     NorrbinParams,
     RVGParams,
+    ShipModel,
     SteeringGear,
     SurgeModel,
     make_model,
@@ -380,6 +381,15 @@ def _pod_lift_force(params: RVGParams, x: np.ndarray) -> np.ndarray:
     return force
 
 
+def _assert_lift_force(base: ShipModel, lift: ShipModel, x: np.ndarray) -> None:
+    """The derivative of ``lift`` differs from that of ``base`` (no lift) at state ``x``, with
+    the inputs held at the state, by ``M^-1`` times :func:`_pod_lift_force`."""
+    inputs = x[6:10]
+    diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
+    expected = _pod_lift_force(lift.params, x)
+    np.testing.assert_allclose(lift.params.mass_matrix @ diff, expected, rtol=1e-9, atol=1e-6)
+
+
 def test_rvg_pod_lift_in_every_inflow_direction_stall_and_flow_from_astern() -> None:
     """The pod normal force for inflows from every direction and any azimuth, astern and beyond
     the stall angle included, against the angles formed explicitly (atan2, wrap, turn by pi,
@@ -390,18 +400,13 @@ def test_rvg_pod_lift_in_every_inflow_direction_stall_and_flow_from_astern() -> 
             "rvg3dof",
             RVGParams(pod_lift_coefficient=6.5e3, pod_slipstream=0.5, pod_stall_angle=stall),
         )
-        params = lift.params
         rng = np.random.default_rng(11)
         for k in range(300):
             u, v = rng.uniform(-4, 4, 2) if k % 10 else (0.0, 0.0)
             r = rng.uniform(-0.1, 0.1) if k % 10 else 0.0
             alpha = rng.uniform(-math.pi, math.pi, 2)
             thrust = rng.uniform(0, 60e3, 2)
-            x = np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha])
-            inputs = [*thrust, *alpha]
-            diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
-            expected = _pod_lift_force(params, x)
-            np.testing.assert_allclose(params.mass_matrix @ diff, expected, rtol=1e-9, atol=1e-6)
+            _assert_lift_force(base, lift, np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha]))
     with pytest.raises(ValueError, match=r"pod_stall_angle must be an angle in \(0, pi/2\)"):
         RVGParams(pod_stall_angle=math.radians(95.0))
 
@@ -413,17 +418,12 @@ def test_rvg_pod_lift_adds_the_foil_force_from_each_pods_inflow() -> None:
     c_l = 6.5e3
     base = make_model("rvg3dof", RVGParams())
     lift = make_model("rvg3dof", RVGParams(pod_lift_coefficient=c_l, pod_slipstream=0.5))
-    params = lift.params
     rng = np.random.default_rng(3)
     for _ in range(20):
         u, v, r = rng.uniform(0.5, 6), rng.uniform(-1, 1), rng.uniform(-0.05, 0.05)
         alpha = rng.uniform(-0.9, 0.9, 2)
         thrust = rng.uniform(0, 60e3, 2)
-        x = np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha])
-        inputs = [*thrust, *alpha]
-        diff = (lift.deriv(x, inputs) - base.deriv(x, inputs))[0, 3:6]
-        expected = _pod_lift_force(params, x)
-        np.testing.assert_allclose(params.mass_matrix @ diff, expected, rtol=1e-9, atol=1e-6)
+        _assert_lift_force(base, lift, np.array([0.0, 0.0, 0.3, u, v, r, *thrust, *alpha]))
     x = np.array([0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 30e3, 30e3, 0.1, 0.1])
     r_dot_base = base.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
     r_dot_lift = lift.deriv(x, [30e3, 30e3, 0.1, 0.1])[0, 5]
