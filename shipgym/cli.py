@@ -727,6 +727,7 @@ def _run_evaluate(args: argparse.Namespace) -> int:
                 env_kwargs=env_kwargs,
                 agents_dir=args.agents,
                 keep_logs=None if plot_dir is not None else 0,
+                design_model=args.model,
             )
     except (EpisodeError, ClusterTaskError) as exc:
         return _campaign_failed(exc)

@@ -279,8 +279,24 @@ def test_mismatch_condition_runs_the_wrong_ship_and_gains_stay_nominal() -> None
     nom = res.get(nomoto, "classic", "nominal")
     assert bech.logs[0].state[0].size == 7 and nom.logs[0].state[0].size == 6  # bech: r_dot
     assert len({tuple(r.returns) for r in (bech, norrbin, nom)}) == 3
-    # the gains stay those of the nominal ship
+    # the gains stay those of the nominal ship: the same episodes as the autopilot designed on
+    # the first-order ship sailing the Bech Mariner, not as one designed on the Bech Mariner
+    from shipgym.benchmark.evaluate import evaluate
+
     assert make_policy("classic", nomoto).nominal == "nomoto1"
+    for design, same in ((None, True), ("bech", False)):
+        direct = evaluate(
+            nomoto, make_policy("classic", nomoto, model=design), "classic", episodes=2,
+            seed=BENCHMARK_SEED, env_kwargs={"model": "bech"}, progress=_quiet,
+        )  # fmt: skip
+        assert (direct.returns == bech.returns) is same, design
+    # the batch that `evaluate --model bech --ray` sends designs on the ship it names
+    from shipgym.benchmark.runner import EpisodeBatch, Scenario
+
+    sailed = Scenario("nominal", env_kwargs={"model": "bech"}, design_model="bech")
+    assert EpisodeBatch(nomoto, "classic", sailed, BENCHMARK_SEED, 2).run().returns == (
+        direct.returns
+    )
     assert set(MISMATCH_SHIPS) == set(ENV_IDS)
     assert MISMATCH_SHIPS[ENV] == {"seed001": {"params": "seed001"}}
     assert MISMATCH_SHIPS["shipgym/RVGHeading-v0"] == {"sea_trials": {"params": "sea_trials"}}

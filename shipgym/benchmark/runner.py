@@ -94,12 +94,19 @@ def condition_order(label: str) -> int:
 
 @dataclass(frozen=True)
 class Scenario:
-    """One condition of one env as :func:`evaluate` runs it."""
+    """One condition of one env as :func:`evaluate` runs it.
+
+    ``design_model`` is the ship the classic controllers of the Nomoto env are designed on
+    (``make_policy(..., model=)``; None: the env's nominal ship). ``shipgym evaluate --model``
+    sails and designs on the same ship; the mismatch condition sails another ship
+    (``env_kwargs``) and keeps the design on the nominal one, as the agents keep their training.
+    """
 
     label: str
     env_kwargs: dict[str, Any] | None = None
     reset_options: dict[str, Any] | None = None
     wrappers: tuple[Callable[[gym.Env], gym.Env], ...] = ()
+    design_model: str | None = None
 
 
 def scenarios(env_id: str, condition: str, stress_current: float) -> list[Scenario]:
@@ -326,7 +333,7 @@ class EpisodeBatch:
                 self.controller,
                 self.env_id,
                 self.agents_dir,
-                model=(self.scenario.env_kwargs or {}).get("model"),
+                model=self.scenario.design_model,
             ),
             self.controller,
             episodes=self.episodes,
@@ -485,9 +492,12 @@ def evaluate_on_ray(
     agents_dir: str | Path | None = None,
     keep_logs: int | None = None,
     progress: Callable[[str], None] | None = None,
+    design_model: str | None = None,
 ) -> EvaluationResult:
     """:func:`~shipgym.benchmark.evaluate.evaluate` of the controller ``controller`` (one of
     :data:`~shipgym.benchmark.policies.POLICIES`) split into Ray tasks; the same result.
+
+    ``design_model`` is the ship the classic controllers are designed on (:class:`Scenario`).
 
     ``address``, ``num_cpus``, ``task_size`` and ``progress`` are those of :func:`run_on_ray`;
     the other parameters those of :func:`~shipgym.benchmark.evaluate.evaluate` (``wrappers``
@@ -510,7 +520,7 @@ def evaluate_on_ray(
     cell = EpisodeBatch(
         env_id,
         controller,
-        Scenario(condition, env_kwargs, reset_options, tuple(wrappers)),
+        Scenario(condition, env_kwargs, reset_options, tuple(wrappers), design_model),
         seed,
         episodes,
         None if agents_dir is None else str(agents_dir),
