@@ -231,6 +231,22 @@ def test_looks_like_nmea():
     assert not looks_like_nmea("time_s,delta_rad,psi_rad\n0,0,0\n")
     assert not looks_like_nmea("")
     assert not looks_like_nmea("t,hdg\n$HEHDT,1,T*00\n")
+    # a logger's banner before the sentences
+    assert looks_like_nmea("Voyage log started 2026-12-31\n" + "$HEHDT,12.3,T*1F\n" * 7)
+
+
+def test_a_log_behind_a_banner_line_is_detected_and_read(tmp_path, ship):
+    """A logger that writes a banner line first: the log is still detected as NMEA, and the
+    reader drops and counts the banner line (nothing unreadable is used)."""
+    from shipgym.sysid.data import detect_format
+
+    plain = _write(tmp_path / "plain.nmea", ship, until=60.0)
+    banner = tmp_path / "banner.nmea"
+    banner.write_text("Bridge logger v3.2, voyage 17\n" + plain.read_text())
+    assert detect_format(banner) == "nmea"
+    rec, ref = _load(banner), _load(plain)
+    np.testing.assert_array_equal(rec.psi, ref.psi)
+    assert any("dropped 1 unreadable line" in r for r in rec.meta["repairs"])
 
 
 def test_write_nmea_refuses_bad_arguments(tmp_path, ship):

@@ -133,6 +133,20 @@ def test_quoted_fields_with_a_decimal_comma(
     assert "decimal comma read as a decimal point" in rec.meta["conversions"]
 
 
+def test_a_windows_export_with_a_degree_sign_is_read(
+    truth: Record, csv_record: Record, tmp_path: Path
+) -> None:
+    """A table in Windows-1252 (``°`` in a header is one byte, not UTF-8) reads as the same
+    record, with a note of the encoding."""
+    text = _table(truth).replace("hdg", "hdg °")
+    path = tmp_path / "windows.csv"
+    path.write_bytes(text.encode("cp1252"))
+    rec = load(path, columns=COLUMNS.replace("psi=hdg:deg", "psi=hdg °:deg"))
+    for name in ("time", "delta", "psi", "r", "U"):
+        np.testing.assert_array_equal(getattr(rec, name), getattr(csv_record, name))
+    assert "not UTF-8: read as Windows-1252 (code page 1252)" in rec.meta["conversions"]
+
+
 def test_unit_suffixes_spelled_per_and_columns_not_read(truth: Record, tmp_path: Path) -> None:
     """``rot_deg_per_min`` is the yaw rate in deg/min; a column no channel takes is named."""
     header = "t_s,rudder_deg,heading_deg,rot_deg_per_min,engine_temp"

@@ -198,9 +198,10 @@ def looks_like_nmea(head: str) -> bool:
     Returns
     -------
     bool
-        True when the first non-empty, non-comment (``#``) line and at least three quarters of
-        the first eight are NMEA sentences (``$`` or ``!`` and an address field), each possibly
-        after a logger time stamp (ISO 8601, bracketed, Unix seconds) or a tag block.
+        True when at least three quarters of the first eight non-empty, non-comment (``#``)
+        lines are NMEA sentences (``$`` or ``!`` and an address field), each possibly after a
+        logger time stamp (ISO 8601, bracketed, Unix seconds) or a tag block: a logger's banner
+        line before the sentences is allowed (the reader drops and counts it).
     """
     lines = head.removeprefix("\ufeff").splitlines()
     if len(lines) > 1 and not head.endswith(("\n", "\r")):
@@ -209,7 +210,7 @@ def looks_like_nmea(head: str) -> bool:
     if not lines:
         return False
     hits = [_HEAD_PREFIX.match(ln) is not None for ln in lines]
-    return hits[0] and sum(hits) >= 0.75 * len(hits)
+    return sum(hits) >= 0.75 * len(hits)
 
 
 # ----------------------------------------------------------------------------------------------

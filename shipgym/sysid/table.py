@@ -48,7 +48,8 @@ Text
 Delimiter ``,``, ``;``, tab or runs of blanks (the one that splits the header into the most
 fields); fields in double quotes (which may hold the delimiter); a decimal comma (``12,5`` with
 ``;``, tab or blanks between fields, or ``"12,5"`` quoted with any); comment lines starting
-with ``#``, ``%`` or ``//`` anywhere; a UTF-8 byte-order mark.
+with ``#``, ``%`` or ``//`` anywhere; UTF-8 with or without a byte-order mark, or else
+Windows-1252 (a Windows export with a degree sign in a header).
 
 Gaps and segments
 -----------------
@@ -494,7 +495,14 @@ def load_table(
         Naming the file and what was wrong: an unknown column, a channel without a stated unit,
         a column of text, time going backwards, fewer than two samples.
     """
-    lines = _read_lines(path)
+    try:
+        lines = _read_lines(path)
+        windows = False
+    except ValueError as exc:  # a Windows export (a degree sign in a header): code page 1252
+        if not isinstance(exc.__cause__, UnicodeDecodeError):
+            raise
+        lines = _read_lines(path, "cp1252")
+        windows = True
     rows = [(k + 1, line) for k, line in enumerate(lines) if not _is_comment(line)]
     if len(rows) < 3:
         raise ValueError(
@@ -560,6 +568,8 @@ def load_table(
     unused = [c for c in cols if c not in used]
     if unused:
         meta["notes"].append(f"column(s) {unused} not read (no channel of a record)")
+    if windows:
+        meta["conversions"].append("not UTF-8: read as Windows-1252 (code page 1252)")
     if decimal_comma:
         meta["conversions"].append("decimal comma read as a decimal point")
     arrays: dict[str, Any] = {}
