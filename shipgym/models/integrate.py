@@ -18,9 +18,11 @@ straight-line code with the sine, cosine and arctangent of :mod:`shipgym.models.
 loop over the ships of a block compiles to SIMD instructions. The model is chosen once per
 block (:func:`block_rhs`), not once per ship and stage. One ship is a block of one (the
 identification's replays hold their ship as a ``(nx, 1)`` block), so every user of a model
-runs the same function and a ship's result does not depend on the batch it is in. The
-model-test models (MMG, VMM), which no environment uses, keep their per-ship functions and
-:func:`rk4_stages`.
+runs the same function and a ship's result does not depend on the batch it is in. A batch
+held as rows (the envs, :func:`rk4_step_kernel`) is stepped block by block by :func:`rk4_rows`
+(gathered into a block, stepped, scattered back; a full block with its width as a compile-time
+constant). The model-test models (MMG, VMM), which no environment uses, keep their per-ship
+functions and :func:`rk4_stages`.
 
 Checked and unchecked entry points
 ----------------------------------

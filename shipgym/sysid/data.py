@@ -960,7 +960,6 @@ def _check_units(
             f"span [{float(np.min(psi_raw)):.6g}, {float(np.max(psi_raw)):.6g}]; expected "
             "radians (convert with numpy.radians)"
         )
-    # rudder and yaw-rate magnitudes (robust to single spikes: 99.9th percentile)
     declared = dict(declared or {})
 
     def stated(channel: str) -> str:
@@ -970,6 +969,7 @@ def _check_units(
             "the right column?"
         )
 
+    # rudder and yaw-rate magnitudes (robust to single spikes: 99.9th percentile)
     big_delta = float(np.percentile(np.abs(delta), 99.9))
     if big_delta > _MAX_RUDDER:
         raise refuse(
