@@ -122,20 +122,15 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
                 f"{self._ended!r}); call env.reset() first"
             )
         task = self.task
-        task.a[0] = _checked_shape(action, task.a.shape[1:], task.act_dim)
+        task.a[0] = _checked_shape(action, (task.act_dim,), task.act_dim)
         if task.step() >= 0:
             raise _bad_action(action, task.act_dim, "it holds NaN or infinity")
-        if task.term[0]:
-            self._ended = REASONS[task.reason[0]]
+        terminated = task.term.item(0)  # (Python scalars read with item: the fastest way)
+        if terminated:
+            self._ended = REASONS[task.reason.item(0)]
         if self.render_mode == "human":
             self.render()
-        return (
-            task.obs[0].astype(np.float32),
-            float(task.rew[0]),
-            bool(task.term[0]),
-            False,
-            task.info(0),
-        )
+        return task.obs[0].astype(np.float32), task.rew.item(0), terminated, False, task.info(0)
 
     def _draw_args(self, i: int) -> dict[str, Any]:
         return {}

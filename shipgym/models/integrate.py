@@ -197,6 +197,10 @@ def rk4_rows(model_id, x, u, p, c, h, rows, start, n, work):
         gather_rows(x, u, c, rows, start, BLOCK, XB, UB, CB)
         rk4_block(model_id, XB, UB, p, CB, h, BLOCK, W)
         scatter_rows(XB, rows, start, BLOCK, x)
+    elif n == 1:
+        gather_rows(x, u, c, rows, start, 1, XB, UB, CB)
+        rk4_block(model_id, XB, UB, p, CB, h, 1, W)
+        scatter_rows(XB, rows, start, 1, x)
     else:
         gather_rows(x, u, c, rows, start, n, XB, UB, CB)
         rk4_block(model_id, XB, UB, p, CB, h, n, W)
