@@ -485,6 +485,41 @@ def _target(
     return -1
 
 
+@kernel
+def set_path_legs(rows, path, n_wp, tangent, leg_length, leg_angle, turn, row_n_wp, seg):
+    """Set the path tables of ``rows`` (at a reset): row ``rows[k]`` follows the first
+    ``n_wp[k]`` of the waypoints ``path[k]`` (north, east) [m], on its first leg.
+
+    ``tangent[i, j]`` holds waypoint ``j`` (the last one repeated up to ``path.shape[1]``,
+    zero after) and the cosine and sine of the course of leg ``j``, from waypoint ``j`` to
+    ``j + 1``; ``leg_length``, ``leg_angle`` (the course, rad) and ``turn`` (the course change
+    at the end of the leg) of each leg; zero after the last leg.
+    """
+    m = path.shape[1]
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        last = n_wp[k] - 1
+        for j in range(tangent.shape[1]):
+            q = min(j, last)
+            tangent[i, j, 0] = path[k, q, 0] if j < m else 0.0
+            tangent[i, j, 1] = path[k, q, 1] if j < m else 0.0
+            tangent[i, j, 2] = tangent[i, j, 3] = 0.0
+        for j in range(leg_length.shape[1]):
+            leg_length[i, j] = leg_angle[i, j] = turn[i, j] = 0.0
+        for j in range(last):
+            dn = path[k, j + 1, 0] - path[k, j, 0]
+            de = path[k, j + 1, 1] - path[k, j, 1]
+            chi = math.atan2(de, dn)
+            tangent[i, j, 2] = math.cos(chi)
+            tangent[i, j, 3] = math.sin(chi)
+            leg_length[i, j] = math.hypot(dn, de)
+            leg_angle[i, j] = chi
+            if j > 0:
+                turn[i, j - 1] = ssa_scalar(chi - leg_angle[i, j - 1])
+        row_n_wp[i] = n_wp[k]
+        seg[i] = 0
+
+
 #: The task kernel of each task family.
 KERNELS = {
     name: kernel(func)

@@ -917,30 +917,12 @@ class RVGPathTask(RVGMixin, Task):
             n_wp = np.full(r, given.shape[0], dtype=np.int64)
         else:
             path, n_wp = self._random_paths(draws)
-        m = path.shape[1]
-        legs = np.diff(path, axis=1)
-        angle = np.arctan2(legs[..., 1], legs[..., 0])
-        # pad every row after its last waypoint with that waypoint (legs of zero length)
-        idx = np.minimum(np.arange(m)[None, :], (n_wp - 1)[:, None])
-        path = np.take_along_axis(path, idx[..., None], axis=1)
-        last_leg = (n_wp - 2)[:, None]
-        leg_idx = np.arange(m - 1)[None, :]
-        valid = leg_idx <= last_leg
-        self.tangent[rows] = 0.0
-        self.tangent[rows, :m, :2] = path
-        self.tangent[rows, : m - 1, 2] = np.where(valid, np.cos(angle), 0.0)
-        self.tangent[rows, : m - 1, 3] = np.where(valid, np.sin(angle), 0.0)
-        self.leg_length[rows] = 0.0
-        self.leg_length[rows, : m - 1] = np.where(valid, np.hypot(legs[..., 0], legs[..., 1]), 0.0)
-        self.leg_angle[rows] = 0.0
-        self.leg_angle[rows, : m - 1] = np.where(valid, angle, 0.0)
-        self.turn[rows] = 0.0
-        if m > 2:
-            self.turn[rows, : m - 2] = np.where(valid[:, 1:], ssa(np.diff(angle, axis=1)), 0.0)
-        self.n_wp[rows] = n_wp
-        self.seg[rows] = 0
+        kernels.set_path_legs(
+            rows, np.ascontiguousarray(path), n_wp, self.tangent, self.leg_length,
+            self.leg_angle, self.turn, self.n_wp, self.seg,
+        )  # fmt: skip
         if "initial_state" not in options:
-            chi0 = angle[:, 0]
+            chi0 = self.leg_angle[rows, 0]
             offset = _uniform(draws[:, 1], -30.0, 30.0)
             self.x[rows, IX] = path[:, 0, 0] - offset * np.sin(chi0)
             self.x[rows, IY] = path[:, 0, 1] + offset * np.cos(chi0)
