@@ -265,3 +265,24 @@ def test_sb3_adapter_keeps_its_reset_options_for_autoresets() -> None:
             venv.step_wait()
         speeds = venv.venv.unwrapped.task.current[:, 0]
         assert bool(np.all(speeds == 0.3)) is keep
+
+
+@pytest.mark.parametrize("env_id", shipgym.ENV_IDS)
+def test_vector_info_arrays_are_new_and_stay_as_they_were(env_id: str) -> None:
+    """No array of a step's ``info`` shares memory with the env (or with another step's): a
+    caller that keeps it sees the values of that step after the next steps."""
+    native, _ = make_pair(env_id, AutoresetMode.NEXT_STEP)
+    native.reset(seed=1)
+    task = native.unwrapped.task
+    actions = np.full((NUM_ENVS, *native.single_action_space.shape), 0.5)
+    info = native.step(actions)[4]
+    kept = {key: value.copy() for key, value in info.items()}
+    owned = [a for a in vars(task).values() if isinstance(a, np.ndarray)]
+    for key, value in info.items():
+        assert not any(np.shares_memory(value, a) for a in owned), key
+    for _ in range(3):
+        later = native.step(actions)[4]
+        for key, value in info.items():
+            assert not np.shares_memory(value, later[key]), key
+    for key, value in info.items():
+        np.testing.assert_array_equal(value, kept[key], err_msg=key)

@@ -260,8 +260,9 @@ class Task:
 
     def batch_metrics(self, rows: slice | np.ndarray) -> dict[str, Any]:
         """Task metrics of ``rows`` for the vector env's ``info``: each metric an array with one
-        entry per row (float64, int64 or bool, possibly a view of the task's arrays:
-        :meth:`batch_info` copies); ``rows`` a slice or an index array.
+        entry per row (float64, int64 or bool): a view of the task's arrays, which
+        :meth:`batch_info` copies, or an array made for the call, never a task's array itself;
+        ``rows`` a slice or an index array.
         """
         raise NotImplementedError
 
@@ -469,7 +470,8 @@ class Task:
             "termination_reason": names,
         }
         for key, value in self.batch_metrics(rows).items():
-            info[key] = np.array(value)
+            # a view of the task's arrays is copied; an array made for this call is new already
+            info[key] = value if value.base is None else value.copy()
         return info
 
 
