@@ -5,13 +5,18 @@ All numbers come from one process, so they share the machine state and are compa
 * **single**: time per ``env.step`` through :func:`gymnasium.make` (so with Gymnasium's
   default wrappers) for ``CartPole-v1`` and every shipgym id, in the same loop: one fixed
   action drawn once from the seeded action space, ``reset`` on ``terminated or truncated``,
-  warm-up steps first, then several timed repeats. Reported: best and median time per step;
-  the ratio ``env_time / cartpole_time`` uses the best repeats (lower is better).
+  warm-up steps first. Ratio ``env_time / cartpole_time`` (lower is better).
 * **vector**: environment steps per second of the NumPy-batched vector envs,
   ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")``, against
   Gymnasium's ``CartPoleVectorEnv(num_envs=N)``, each stepped with one fixed batch of random
-  actions (autoreset inside the env). Ratio ``env_sps / cartpole_sps`` from the best repeats
-  (higher is better).
+  actions (autoreset inside the env). Ratio ``env_sps / cartpole_sps`` (higher is better).
+
+Every env is made and warmed up first; then each of the ``repeats`` rounds times one loop of
+every measurement in turn, CartPole included, and a measurement's ratio is the median over the
+rounds of its ratio to CartPole in the same round. A shared machine changes speed by tens of
+per cent from one minute to the next (a neighbour's load, the clock); within a round both sides
+of a ratio see the same machine, so such a change cancels, where ratios of values timed minutes
+apart would carry it. Reported besides: the best and the median of each measurement's values.
 
 Each vector env is measured on one thread (``num_threads=1``, the default) and on one thread
 per CPU (``num_threads=None``); ``busy=N`` (``shipgym bench --busy N``) runs the whole
@@ -32,7 +37,6 @@ import platform
 import statistics
 import sys
 import time
-from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
@@ -74,11 +78,13 @@ class Measurement:
     best, median : float
         Single: seconds per step; vector: environment steps per second.
     repeats : list of float
-        Every repeat (same unit).
+        Every repeat (same unit), one per round.
     threads : int
         Threads of a vector env's step (``num_threads``); 1 for the single env and CartPole.
     ratio : float or None
-        Against CartPole (``None`` for the CartPole lines themselves).
+        Against CartPole: the median of ``round_ratios`` (``None`` for the CartPole lines).
+    round_ratios : list of float
+        The ratio to CartPole timed in the same round, one per round.
     target : str or None
         E.g. ``"<= 1.0"``.
     passed : bool or None
@@ -91,6 +97,7 @@ class Measurement:
     repeats: list[float] = field(default_factory=list)
     threads: int = 1
     ratio: float | None = None
+    round_ratios: list[float] = field(default_factory=list)
     target: str | None = None
     passed: bool | None = None
 
@@ -111,30 +118,56 @@ def _check_target(
     return f"{op} {value}", bool(passed)
 
 
-def time_single(env_id: str, steps: int, repeats: int, warmup: int, seed: int = 0) -> list[float]:
-    """Seconds per step of ``gymnasium.make(env_id)`` for each of ``repeats`` timed loops."""
-    env = gym.make(env_id)
-    try:
-        env.action_space.seed(seed)
-        action = env.action_space.sample()
-        env.reset(seed=seed)
-        step, reset = env.step, env.reset
+class _Loop:
+    """One measurement's env, made and warmed up once, then timed one repeat at a time.
 
-        def loop(n: int) -> None:
+    ``kind`` ``"single"``: ``gymnasium.make(env_id)``, :meth:`time` returns seconds per step;
+    ``"vector"``: a vector env of ``num_envs`` (``threads``: its ``num_threads``), :meth:`time`
+    returns environment steps per second.
+    """
+
+    def __init__(
+        self,
+        kind: str,
+        env_id: str,
+        steps: int,
+        warmup: int,
+        num_envs: int = 1,
+        threads: int = 1,
+        seed: int = 0,
+    ) -> None:
+        self.kind, self.steps, self.num_envs = kind, steps, num_envs
+        self.env: Any = (
+            gym.make(env_id) if kind == "single" else _make_vector(env_id, num_envs, threads)
+        )
+        self.env.action_space.seed(seed)
+        self.action = self.env.action_space.sample()
+        self.env.reset(seed=seed)
+        self._run(warmup)
+
+    def _run(self, n: int) -> None:
+        step, action = self.env.step, self.action
+        if self.kind == "vector":  # (autoreset inside the env)
             for _ in range(n):
-                _, _, terminated, truncated, _ = step(action)
-                if terminated or truncated:
-                    reset()
+                step(action)
+            return
+        reset = self.env.reset
+        for _ in range(n):
+            _, _, terminated, truncated, _ = step(action)
+            if terminated or truncated:
+                reset()
 
-        loop(warmup)
-        out = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            loop(steps)
-            out.append((time.perf_counter() - t0) / steps)
-        return out
-    finally:
-        env.close()
+    def time(self) -> float:
+        """Time one repeat: seconds per step (single) or environment steps per second."""
+        t0 = time.perf_counter()
+        self._run(self.steps)
+        elapsed = time.perf_counter() - t0
+        return (
+            elapsed / self.steps if self.kind == "single" else self.steps * self.num_envs / elapsed
+        )
+
+    def close(self) -> None:
+        self.env.close()
 
 
 def _make_vector(env_id: str, num_envs: int, threads: int = 1) -> gym.vector.VectorEnv:
@@ -145,36 +178,6 @@ def _make_vector(env_id: str, num_envs: int, threads: int = 1) -> gym.vector.Vec
     return gym.make_vec(
         env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", num_threads=threads
     )
-
-
-def time_vector(
-    env_id: str,
-    num_envs: int,
-    steps: int,
-    repeats: int,
-    warmup: int,
-    seed: int = 0,
-    threads: int = 1,
-) -> list[float]:
-    """Environment steps per second of a vector env for each of ``repeats`` timed loops
-    (``threads``: its ``num_threads``)."""
-    env = _make_vector(env_id, num_envs, threads)
-    try:
-        env.action_space.seed(seed)
-        actions = env.action_space.sample()
-        env.reset(seed=seed)
-        step = env.step
-        for _ in range(warmup):
-            step(actions)
-        out = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            for _ in range(steps):
-                step(actions)
-            out.append(steps * num_envs / (time.perf_counter() - t0))
-        return out
-    finally:
-        env.close()
 
 
 def _spin(stop: Any) -> None:  # pragma: no cover - runs in a helper process
@@ -249,14 +252,14 @@ def run_bench(
     num_envs : int
         Batch size of the vector envs.
     repeats : int
-        Timed repeats per measurement.
+        Rounds: each times one repeat of every measurement, CartPole included.
     vec_steps : int, optional
         Timed batched steps per repeat of the vector loop; default ``max(5, steps // 200)``.
     env_ids : tuple of str
         shipgym ids to measure.
     progress : file or bool
-        Where a line per measurement is printed as it completes: a file, ``True`` for
-        ``sys.stderr`` (the default) or ``False`` for silence.
+        Where a line per round (as it completes) and a line per measurement are printed: a
+        file, ``True`` for ``sys.stderr`` (the default) or ``False`` for silence.
     threads : tuple of int or None
         ``num_threads`` values each vector env is measured with (``None``: one thread per
         CPU; a value equal to an earlier one is measured once).
@@ -291,45 +294,52 @@ def run_bench(
     warmup = max(10, steps // 10)
     vec_warmup = max(2, vec_steps // 10)
 
-    plan: list[tuple[str, str, int, Callable[[], list[float]]]] = []
-    for env_id in (CARTPOLE_ID, *env_ids):
-        plan.append(("single", env_id, 1, lambda e=env_id: time_single(e, steps, repeats, warmup)))
+    plan: list[tuple[str, str, int]] = [("single", e, 1) for e in (CARTPOLE_ID, *env_ids)]
     for env_id in (CARTPOLE_VECTOR, *env_ids):
         for count in [1] if env_id == CARTPOLE_VECTOR else thread_counts:
-            plan.append(
-                (
-                    "vector",
-                    env_id,
-                    count,
-                    lambda e=env_id, c=count: time_vector(
-                        e, num_envs, vec_steps, repeats, vec_warmup, threads=c
-                    ),
+            plan.append(("vector", env_id, count))
+
+    def say(line: str) -> None:
+        if stream is not None:
+            print(line, file=stream, flush=True)
+
+    t_start = time.perf_counter()
+    values: list[list[float]] = [[] for _ in plan]
+    loops: list[_Loop] = []
+    with busy_cores:
+        try:
+            for kind, env_id, count in plan:  # make and warm up every env first
+                single = kind == "single"
+                loops.append(
+                    _Loop(kind, env_id, steps, warmup)
+                    if single
+                    else _Loop(kind, env_id, vec_steps, vec_warmup, num_envs, count)
                 )
-            )
+            say(f"shipgym bench: {len(plan)} envs made and warmed up; {repeats} rounds")
+            for r in range(repeats):  # every measurement once per round
+                for k, loop in enumerate(loops):
+                    values[k].append(loop.time())
+                say(f"  round {r + 1}/{repeats} done ({time.perf_counter() - t_start:.0f} s)")
+        finally:
+            for loop in loops:
+                loop.close()
 
     results: list[Measurement] = []
-    reference: dict[str, float] = {}
-    t_start = time.perf_counter()
-    with busy_cores:
-        for k, (kind, env_id, count, measure) in enumerate(plan, start=1):
-            values = measure()
-            best = min(values) if kind == "single" else max(values)
-            m = Measurement(kind, env_id, best, statistics.median(values), values, count)
-            if env_id in (CARTPOLE_ID, CARTPOLE_VECTOR):
-                reference[kind] = best
-            else:
-                m.ratio = best / reference[kind]
-                if not busy:  # the targets are for an idle machine
-                    m.target, m.passed = _check_target(kind, env_id, count, m.ratio)
-            results.append(m)
-            if stream is not None:
-                extra = "" if m.ratio is None else f"  ratio {m.ratio:.3f}"
-                where = f"{env_id} ({count} thr)" if kind == "vector" else env_id
-                print(
-                    f"[{k:2d}/{len(plan)}] {kind:6s} {where:38s} {_fmt_value(m)}{extra}",
-                    file=stream,
-                    flush=True,
-                )
+    reference = {kind: values[k] for k, (kind, env_id, _) in enumerate(plan)
+                 if env_id in (CARTPOLE_ID, CARTPOLE_VECTOR)}  # fmt: skip
+    for k, (kind, env_id, count) in enumerate(plan, start=1):
+        v = values[k - 1]
+        best = min(v) if kind == "single" else max(v)
+        m = Measurement(kind, env_id, best, statistics.median(v), v, count)
+        if env_id not in (CARTPOLE_ID, CARTPOLE_VECTOR):
+            m.round_ratios = [a / b for a, b in zip(v, reference[kind], strict=True)]
+            m.ratio = statistics.median(m.round_ratios)
+            if not busy:  # the targets are for an idle machine
+                m.target, m.passed = _check_target(kind, env_id, count, m.ratio)
+        results.append(m)
+        extra = "" if m.ratio is None else f"  ratio {m.ratio:.3f}"
+        where = f"{env_id} ({count} thr)" if kind == "vector" else env_id
+        say(f"[{k:2d}/{len(plan)}] {kind:6s} {where:38s} {_fmt_value(m)}{extra}")
 
     ratios: dict[str, dict[str, float]] = {"single": {}, "vector": {}}
     for m in results:
@@ -348,7 +358,10 @@ def run_bench(
             "vec_warmup": vec_warmup,
             "single_reference": CARTPOLE_ID,
             "vector_reference": CARTPOLE_VECTOR,
-            "statistic": "best of the repeats (min time per step, max steps per second)",
+            "statistic": (
+                "ratio: median over the rounds of the ratio to CartPole timed in the same round; "
+                "best: min time per step, max steps per second"
+            ),
         },
         "system": {
             "shipgym": shipgym.__version__,
@@ -381,8 +394,9 @@ def format_table(report: dict[str, Any]) -> str:
     """The results as a plain-text table (Markdown-compatible)."""
     cfg = report["config"]
     lines = [
-        f"shipgym bench: best of {cfg['repeats']} repeats; single env {cfg['steps']} steps per "
-        f"repeat via gymnasium.make; vector {cfg['num_envs']} envs x {cfg['vec_steps']} steps"
+        f"shipgym bench: {cfg['repeats']} rounds, ratio = median over the rounds of the ratio to "
+        f"CartPole in the same round; single env {cfg['steps']} steps per round via "
+        f"gymnasium.make; vector {cfg['num_envs']} envs x {cfg['vec_steps']} steps"
         + (f"; {cfg['busy']} busy helper processes" if cfg.get("busy") else "; idle"),
         "",
         "| measurement | env | threads | best | median | ratio vs CartPole | target | result |",

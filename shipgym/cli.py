@@ -138,8 +138,8 @@ def _run_bench(args: argparse.Namespace) -> int:
     json_path = _output_path(args.json, "--json", ".json")
     plot_path = _output_path(args.plot, "--plot", ".png")
     print(
-        f"shipgym bench: single env {args.steps} steps x {args.repeats} repeats, vector "
-        f"{args.num_envs} envs; one line per measurement as it completes",
+        f"shipgym bench: single env {args.steps} steps x {args.repeats} rounds, vector "
+        f"{args.num_envs} envs; a line per round as it completes",
         file=sys.stderr,
         flush=True,
     )
@@ -171,7 +171,8 @@ def _build_bench(sub: Any) -> None:
         description=(
             "Measure, in one process, the single-env step time (via gymnasium.make) and the "
             "vector-env throughput (vector_entry_point) of every shipgym env relative to "
-            "CartPole-v1 and CartPoleVectorEnv, and compare the ratios with the targets. "
+            "CartPole-v1 and CartPoleVectorEnv, timed in interleaved rounds, and compare the "
+            "ratios with the targets. "
             "The exit code does not depend on PASS/MISS."
         ),
     )
@@ -194,7 +195,10 @@ def _build_bench(sub: Any) -> None:
         type=_int_in(1, 1000),
         default=DEFAULT_REPEATS,
         metavar="N",
-        help="timed repeats per measurement, best one counts (default: %(default)s)",
+        help=(
+            "rounds, each timing every measurement once; a ratio is the median over the "
+            "rounds of the ratio to CartPole in the same round (default: %(default)s)"
+        ),
     )
     p.add_argument(
         "--vec-steps",

@@ -6,6 +6,7 @@ import json
 import math
 import os
 import re
+import statistics
 import subprocess
 import sys
 import time
@@ -59,7 +60,7 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
         "--num-envs",
         "4",
         "--repeats",
-        "1",
+        "3",
         "--json",
         str(out),
         "--plot",
@@ -81,7 +82,17 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
     # a table row per measurement with PASS/MISS where there is a target
     assert captured.out.count("| single env step time |") == len(CURRENT_ENV_IDS) + 1
     assert re.search(r"NomotoHeading-v0 .*\| (PASS|MISS) \|", captured.out)
-    # progress: one line per measurement
+    # each ratio is the median of the ratios to CartPole timed in the same round
+    results = report["results"]
+    reference = {r["kind"]: r["repeats"] for r in results if r["ratio"] is None}
+    for r in results:
+        assert len(r["repeats"]) == 3
+        if r["ratio"] is not None:
+            same_round = [a / b for a, b in zip(r["repeats"], reference[r["kind"]], strict=True)]
+            assert r["round_ratios"] == pytest.approx(same_round, rel=1e-12)
+            assert r["ratio"] == pytest.approx(statistics.median(same_round), rel=1e-12)
+    # progress: a line per round, then one per measurement
+    assert len(re.findall(r"^  round \d/3 done", captured.err, flags=re.M)) == 3
     n = 2 * (len(CURRENT_ENV_IDS) + 1) + len(CURRENT_ENV_IDS) * (len(counts) - 1)
     assert len(re.findall(rf"^\[\s*\d+/{n}\]", captured.err, flags=re.M)) == n
 
