@@ -194,3 +194,27 @@ def test_the_gunnerus_task_kernels_refuse_another_ship(env_id: str) -> None:
     with pytest.raises(ValueError, match="sail the R/V Gunnerus"):
         kernels.KERNELS[task.kernel_name](*args)
     np.testing.assert_array_equal(task.x, before)
+
+
+@pytest.mark.parametrize("name", ["nomoto1", "nomoto2", "norrbin", "bech"])
+def test_full_blocks_step_each_model_as_the_single_env_does(name: str) -> None:
+    """The vector env steps its full blocks with each model's own copy of the RK4 step, the
+    single env a block of one with the step shared by all models: the same numbers, bitwise."""
+    import gymnasium as gym
+
+    n = BLOCK + 3
+    venv = gym.make_vec(
+        "shipgym/NomotoHeading-v0", num_envs=n, vectorization_mode="vector_entry_point", model=name
+    )
+    venv.reset(seed=4)
+    actions = np.random.default_rng(2).uniform(-1.0, 1.0, (5, n, 1))
+    for a in actions:
+        venv.step(a)
+    states = venv.unwrapped.task.x
+    for i in (0, BLOCK - 1, BLOCK + 2):
+        env = gym.make("shipgym/NomotoHeading-v0", model=name)
+        env.reset(seed=4 + i)
+        for a in actions:
+            env.step(a[i])
+        assert np.array_equal(env.unwrapped.task.x[0], states[i]), i
+    assert np.ptp(states[:, 4]) > 0.0  # the ships turn, differently

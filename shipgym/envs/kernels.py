@@ -39,7 +39,14 @@ from numba.core.dispatcher import Dispatcher
 
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.angles import ssa_scalar
-from shipgym.models.integrate import BLOCK, RVG3DOF, block_work, rk4_rows
+from shipgym.models.integrate import (
+    BLOCK,
+    RVG3DOF,
+    block_work,
+    full_block_by_model,
+    full_block_rvg,
+    rk4_rows,
+)
 from shipgym.models.rvg import P_TBOLL
 from shipgym.models.vmath import exp, sincos
 
@@ -67,7 +74,7 @@ def _require_rvg(model_id):
 
 
 @row_kernel
-def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
+def _advance_block(full_block, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
     """Clip the actions of rows ``rows[start .. start + n - 1]`` to [-1, 1], map them to inputs
     (``u = u0 + B a``), count their step and take one RK4 step of the block
     (:func:`~shipgym.models.integrate.rk4_rows`).
@@ -85,7 +92,7 @@ def _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, wo
                 acc += B[q, k] * a[i, k]
             u[i, q] = acc
         steps[i] += 1
-    rk4_rows(model_id, x, u, p, c, dt, rows, start, n, work)
+    rk4_rows(full_block, model_id, x, u, p, c, dt, rows, start, n, work)
 
 
 # The row logic of the task kernels works a block of rows at a time: a helper that takes arrays
@@ -189,7 +196,9 @@ def _heading(
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
-            _advance_block(model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            _advance_block(
+                full_block_by_model, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+            )
         _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if ok[b]:
@@ -245,7 +254,9 @@ def _speed(
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
-            _advance_block(RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            _advance_block(
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+            )
         _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if ok[b]:
@@ -341,7 +352,9 @@ def _path(
                 leg_length[i, k],
             )[1]
         if advance:
-            _advance_block(RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            _advance_block(
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+            )
         _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
         for b in range(m):
             if not ok[b]:
@@ -447,7 +460,9 @@ def _target(
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
-            _advance_block(RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work)
+            _advance_block(
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+            )
             for b in range(m):
                 i = rows[start + b]
                 target[i, 0] += target_vel[i, 0] * dt
