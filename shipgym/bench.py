@@ -502,8 +502,9 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
     fig.legend(handles=handles, loc="outside lower center", ncols=5, fontsize=9)
     sysinfo = report["system"]
     fig.suptitle(
-        f"shipgym {sysinfo['shipgym']} speed vs Gymnasium CartPole (one process; "
-        f"{sysinfo['cpu_count']} CPUs, numba {sysinfo['numba']})",
+        f"shipgym {sysinfo['shipgym']} speed vs Gymnasium CartPole (one process, "
+        f"{sysinfo['cpu_count']} CPUs, numba {sysinfo['numba']})\neach ratio: the median over "
+        f"{cfg['repeats']} rounds of the ratio to CartPole timed in the same round",
         fontsize=11,
     )
     out = Path(path)
