@@ -88,38 +88,19 @@ _PARAMETER_COUNTS = (
 BLOCK = 32
 
 
-# Each environment model's derivative over ships 0 .. n-1 of a block: a loop of straight-line
-# code that compiles to SIMD instructions.
+@row_kernel
+def _cols(col, X, U, p, C, K, n):
+    """Derivative of ships ``0 .. n-1`` of a block by the per-ship model function ``col``
+    (``nomoto1_col``, ...): a loop of straight-line code that compiles to SIMD instructions."""
+    for b in range(n):
+        col(X, U, p, C, K, b)
 
 
 @row_kernel
-def _nomoto1_block(model_id, X, U, p, C, K, n):
-    for b in range(n):
-        nomoto1_col(X, U, p, C, K, b)
-
-
-@row_kernel
-def _nomoto2_block(model_id, X, U, p, C, K, n):
-    for b in range(n):
-        nomoto2_col(X, U, p, C, K, b)
-
-
-@row_kernel
-def _norrbin_block(model_id, X, U, p, C, K, n):
-    for b in range(n):
-        norrbin_col(X, U, p, C, K, b)
-
-
-@row_kernel
-def _bech_block(model_id, X, U, p, C, K, n):
-    for b in range(n):
-        bech_col(X, U, p, C, K, b)
-
-
-@row_kernel
-def _rvg_block(model_id, X, U, p, C, K, n):
-    for b in range(n):
-        rvg_col(X, U, p, C, K, b)
+def _rvg_cols(col, X, U, p, C, K, n):
+    """:func:`_cols` of the RVG (``col`` is ``rvg_col``), and the cross-flow terms in a loop of
+    their own where their coefficient is not zero."""
+    _cols(col, X, U, p, C, K, n)
     if p[P_CF] != 0.0:
         for b in range(n):
             rvg_crossflow_col(X, p, C, K, b)
@@ -134,21 +115,22 @@ def block_rhs(model_id, X, U, p, C, K, n):
     code that compiles to SIMD instructions.
     """
     if model_id == NOMOTO1:
-        _nomoto1_block(model_id, X, U, p, C, K, n)
+        _cols(nomoto1_col, X, U, p, C, K, n)
     elif model_id == NOMOTO2:
-        _nomoto2_block(model_id, X, U, p, C, K, n)
+        _cols(nomoto2_col, X, U, p, C, K, n)
     elif model_id == NORRBIN:
-        _norrbin_block(model_id, X, U, p, C, K, n)
+        _cols(norrbin_col, X, U, p, C, K, n)
     elif model_id == BECH:
-        _bech_block(model_id, X, U, p, C, K, n)
+        _cols(bech_col, X, U, p, C, K, n)
     else:
-        _rvg_block(model_id, X, U, p, C, K, n)
+        _rvg_cols(rvg_col, X, U, p, C, K, n)
 
 
 @row_kernel
-def _rk4(block_deriv, nx, model_id, X, U, p, C, h, n, W):
+def _rk4(block_deriv, model, nx, X, U, p, C, h, n, W):
     """The RK4 step of :func:`rk4_block` with the block derivative
-    ``block_deriv(model_id, X, U, p, C, K, n)`` of ships with ``nx`` states."""
+    ``block_deriv(model, X, U, p, C, K, n)`` of ships with ``nx`` states (``model`` is a model
+    id for :func:`block_rhs`, a per-ship model function for :func:`_cols`)."""
     K = W[0]
     A = W[1]
     T = W[2]
@@ -156,7 +138,7 @@ def _rk4(block_deriv, nx, model_id, X, U, p, C, h, n, W):
         for b in range(n):
             T[j, b] = X[j, b]
     for s in range(4):
-        block_deriv(model_id, T, U, p, C, K, n)
+        block_deriv(model, T, U, p, C, K, n)
         if s == 0:
             for j in range(nx):
                 for b in range(n):
@@ -184,7 +166,7 @@ def rk4_block(model_id, X, U, p, C, h, n, W):
     stages (compile time and code size grow with every inlined copy of a model), and the same
     arrays at every stage (a loop over differing arrays does not vectorise as well).
     """
-    _rk4(block_rhs, X.shape[0], model_id, X, U, p, C, h, n, W)
+    _rk4(block_rhs, model_id, X.shape[0], X, U, p, C, h, n, W)
 
 
 # The RK4 step of a full block of BLOCK ships (rk4_rows' first argument): the block's width is a
@@ -204,21 +186,21 @@ def full_block_by_model(model_id, X, U, p, C, h, W):
     of states known: the loops have known trip counts (the first-order Nomoto model's step
     1.55 x faster than :func:`full_block_any`'s, the RVG's 1.13 x; more code to compile)."""
     if model_id == NOMOTO1:
-        _rk4(_nomoto1_block, _NX_FIRST, model_id, X, U, p, C, h, BLOCK, W)
+        _rk4(_cols, nomoto1_col, _NX_FIRST, X, U, p, C, h, BLOCK, W)
     elif model_id == NOMOTO2:
-        _rk4(_nomoto2_block, _NX_SECOND, model_id, X, U, p, C, h, BLOCK, W)
+        _rk4(_cols, nomoto2_col, _NX_SECOND, X, U, p, C, h, BLOCK, W)
     elif model_id == NORRBIN:
-        _rk4(_norrbin_block, _NX_FIRST, model_id, X, U, p, C, h, BLOCK, W)
+        _rk4(_cols, norrbin_col, _NX_FIRST, X, U, p, C, h, BLOCK, W)
     elif model_id == BECH:
-        _rk4(_bech_block, _NX_SECOND, model_id, X, U, p, C, h, BLOCK, W)
+        _rk4(_cols, bech_col, _NX_SECOND, X, U, p, C, h, BLOCK, W)
     else:
-        _rk4(_rvg_block, _NX_RVG, model_id, X, U, p, C, h, BLOCK, W)
+        _rk4(_rvg_cols, rvg_col, _NX_RVG, X, U, p, C, h, BLOCK, W)
 
 
 @row_kernel
 def full_block_rvg(model_id, X, U, p, C, h, W):
     """:func:`full_block_by_model` of the R/V Gunnerus alone (no other model's code)."""
-    _rk4(_rvg_block, _NX_RVG, model_id, X, U, p, C, h, BLOCK, W)
+    _rk4(_rvg_cols, rvg_col, _NX_RVG, X, U, p, C, h, BLOCK, W)
 
 
 @row_kernel
