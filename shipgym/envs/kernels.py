@@ -48,7 +48,7 @@ from shipgym.models.integrate import (
     rk4_rows,
 )
 from shipgym.models.rvg import P_TBOLL
-from shipgym.models.vmath import exp, sincos
+from shipgym.models.vmath import sincos
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
 #: Batches at least this large are split over the threads of :func:`run_threaded`.
@@ -408,7 +408,7 @@ def _path(
             obs[i, 8] = x[i, 6] / tb
             rew[i] = (
                 0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
-                + 0.5 * exp(-((e / 25.0) ** 2))
+                + 0.5 * math.exp(-((e / 25.0) ** 2))
                 - 0.1 * abs(chi_err) / math.pi
                 - 0.05 * cost[b]
                 + bonus

@@ -318,7 +318,7 @@ class Task:
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
-        state["_step_call"] = state["_step_args"] = None  # (compiled code: made anew)
+        state["_step_call"], state["_step_args"] = None, ()  # (compiled code: made anew)
         return state
 
     def reset_rows(

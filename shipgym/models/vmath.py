@@ -1,5 +1,4 @@
-"""Sine, cosine, arctangent and exponential as straight-line arithmetic, so that batch loops
-vectorise.
+"""Sine, cosine and arctangent as straight-line arithmetic, so that batch loops vectorise.
 
 The physics kernels loop over a block of ships (:mod:`shipgym.models.integrate`). A call to the
 C library's ``sin``, ``cos`` or ``atan2`` inside such a loop keeps the compiler from turning
@@ -20,18 +19,11 @@ rudder angles), NaN for NaN and infinite arguments (where ``math.sin`` would rai
 * :func:`atan2`: Cephes' ``atan`` (rational approximation after reduction to ``|t| <= 0.66``
   with ``tan(3 pi/8)`` and ``pi/4`` splits) and the quadrant rules of C's ``atan2`` for finite
   arguments.
-* :func:`exp`: Cephes' ``exp`` (reduction by ``ln 2`` in two parts, a Pade form on
-  ``|r| <= ln(2) / 2``), scaled by two exact powers of two built from their bits, so that
-  results down to the subnormal range are right; 0 below ``-745.2``, ``inf`` above ``709.8``.
 """
 
 from __future__ import annotations
 
 import math
-
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
 
 from shipgym.models._jit import row_kernel
 
@@ -121,47 +113,3 @@ def atan2(y, x):
     a = atan_positive(ay / ax if ay != 0.0 else 0.0)  # ay / 0 = inf: pi/2
     left = x < 0.0 or (x == 0.0 and math.copysign(1.0, x) < 0.0)
     return math.copysign(math.pi - a if left else a, y)
-
-
-# Cephes exp: ln 2 in two parts and the Pade coefficients on |r| <= ln(2) / 2
-_LOG2E = 1.4426950408889634073599
-_LN2_HI = 6.93145751953125e-1
-_LN2_LO = 1.42860682030941723212e-6
-_EP0, _EP1, _EP2 = 1.26177193074810590878e-4, 3.02994407707441961300e-2, 9.99999999999999999910e-1
-_EQ0, _EQ1, _EQ2, _EQ3 = (
-    3.00198505138664455042e-6, 2.52448340349684104192e-3, 2.27265548208155028766e-1,
-    2.00000000000000000009e0,
-)  # fmt: skip
-_EXP_MAX = 709.782712893384  # exp overflows above
-_EXP_MIN = -745.2  # exp rounds to 0 below
-
-
-@intrinsic
-def _pow2(typingctx, n):  # type: ignore[no-untyped-def]
-    """``2.0 ** n`` for an integer ``-1022 <= n <= 1023``, from its IEEE bits (no call)."""
-    sig = types.float64(types.int64)
-
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
-        i64 = ir.IntType(64)
-        bits = builder.shl(builder.add(args[0], ir.Constant(i64, 1023)), ir.Constant(i64, 52))
-        return builder.bitcast(bits, ir.DoubleType())
-
-    return sig, codegen
-
-
-@row_kernel
-def exp(x):
-    """``exp(x)`` of a float without a library call (module docstring); NaN for NaN."""
-    xc = _EXP_MIN if x < _EXP_MIN else x  # (NaN stays NaN)
-    xc = _EXP_MAX if xc > _EXP_MAX else xc
-    k = (xc * _LOG2E + _ROUND) - _ROUND  # nearest integer, as a float
-    r = (xc - k * _LN2_HI) - k * _LN2_LO
-    rr = r * r
-    px = r * ((_EP0 * rr + _EP1) * rr + _EP2)
-    e = 1.0 + 2.0 * (px / ((((_EQ0 * rr + _EQ1) * rr + _EQ2) * rr + _EQ3) - px))
-    n = int(k) if k == k else 0  # (a NaN k would make the conversion undefined)
-    half = n >> 1  # two factors, each a normal number, for results down to the subnormals
-    y = e * _pow2(half) * _pow2(n - half)
-    if x < _EXP_MIN:
-        return 0.0
-    return math.inf if x > _EXP_MAX else y
