@@ -243,7 +243,9 @@ def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
     A full block is stepped with its width :data:`BLOCK` as a compile-time constant: the loops
     over its ships then have a known trip count, with no remainder loops and no run-time checks
     at every loop (1.2 x faster for the RVG, 1.8 x for a Nomoto model, than the same step with
-    the width known at run time only, which the last, partial block of a batch keeps).
+    the width known at run time only, which the last, partial block of a batch keeps). So is a
+    block of one ship (the single env's step): a loop whose width is known at run time only
+    costs about 60 ns to set up, more than one ship's derivative.
     """
     XB, UB, CB, W = work
     if n == BLOCK:
