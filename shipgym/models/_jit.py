@@ -30,7 +30,9 @@ from typing import Any, TypeVar
 
 import llvmlite.binding as llvm
 import numba
+import numpy as np
 from numba.core.caching import FunctionCache
+from numba.extending import overload
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -158,3 +160,45 @@ def simd_kernel(func: F) -> F:
     vectorising it.
     """
     return _compile(func, nogil=True, error_model="numpy", forceinline=True)
+
+
+def param(p: Any, k: int, b: int) -> float:
+    """Parameter ``k`` of ship ``b`` of a block, in the model functions.
+
+    ``p`` is either the model's one packed parameter vector, shared by every ship of the block
+    (the environments, the manoeuvres, a single replay), or a table of shape
+    ``(n_parameters, ships)`` with a parameter vector per ship, column ``b`` for ship ``b``
+    (identification, which steps the variants of a model that a finite-difference Jacobian
+    needs side by side as the ships of one block). Chosen when the caller is compiled, from the
+    dimensions of ``p``: a shared vector compiles to the same code as ``p[k]``, and a table to
+    loads along the block's ships, which keep the loop over them SIMD code.
+    """
+    return float(p[k] if np.ndim(p) == 1 else p[k, b])
+
+
+def param_nonzero(p: Any, k: int, n: int) -> bool:
+    """Whether parameter ``k`` (:func:`param`) is not zero for any of ships ``0 .. n-1``."""
+    return bool(np.any(p[k] != 0.0) if np.ndim(p) == 1 else np.any(p[k, :n] != 0.0))
+
+
+@overload(param, jit_options={"nogil": True, "error_model": "numpy", "forceinline": True})
+def _param(p, k, b):  # type: ignore[no-untyped-def]  # Numba matches the names
+    """Numba's implementation of :func:`param` for the type of ``p``."""
+    if p.ndim == 1:
+        return lambda p, k, b: p[k]
+    return lambda p, k, b: p[k, b]
+
+
+@overload(param_nonzero, jit_options={"nogil": True, "error_model": "numpy"})
+def _param_nonzero(p, k, n):  # type: ignore[no-untyped-def]
+    """Numba's implementation of :func:`param_nonzero` for the type of ``p``."""
+    if p.ndim == 1:
+        return lambda p, k, n: p[k] != 0.0
+
+    def table(p, k, n):  # type: ignore[no-untyped-def]
+        for b in range(n):
+            if p[k, b] != 0.0:
+                return True
+        return False
+
+    return table

@@ -53,7 +53,7 @@ import numpy as np
 
 from shipgym.models import mmg, nomoto, rvg, vmm
 from shipgym.models._checks import real_array, require_finite, shape_error, step_size
-from shipgym.models._jit import kernel, row_kernel
+from shipgym.models._jit import kernel, param_nonzero, row_kernel
 from shipgym.models.mmg import mmg_row
 from shipgym.models.nomoto import bech_col, nomoto1_col, nomoto2_col, norrbin_col
 from shipgym.models.rvg import P_CF, rvg_col, rvg_crossflow_col
@@ -86,6 +86,9 @@ _PARAMETER_COUNTS = (
 #: Ships per block of :func:`rk4_block` in the batch kernels (a block's work arrays stay in
 #: the first-level cache; a multiple of the SIMD width).
 BLOCK = 32
+#: Ships a loop over a block steps at once with AVX-512 (float64), a multiple of AVX2's 4: a
+#: block whose width is a multiple of it runs in whole vectors, without a scalar remainder.
+SIMD_LANES = 8
 
 
 @row_kernel
@@ -101,7 +104,7 @@ def _rvg_cols(col, X, U, p, C, K, n):
     """:func:`_cols` of the RVG (``col`` is ``rvg_col``), and the cross-flow terms in a loop of
     their own where their coefficient is not zero."""
     _cols(col, X, U, p, C, K, n)
-    if p[P_CF] != 0.0:
+    if param_nonzero(p, P_CF, n):
         for b in range(n):
             rvg_crossflow_col(X, p, C, K, b)
 

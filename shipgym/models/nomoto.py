@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from shipgym.models._jit import simd_kernel
+from shipgym.models._jit import param, simd_kernel
 from shipgym.models.vmath import sincos
 
 # Shared state and input indices of the Nomoto family.
@@ -269,17 +269,17 @@ def _actuators_and_kinematics(X, U, p, C, b):
     Straight-line code (the sine and cosine of :mod:`shipgym.models.vmath`) that reads every
     input before it writes, so a loop over the ships compiles to SIMD code.
     """
-    dmax = p[P_DMAX]
-    rate = p[P_DRATE]
+    dmax = param(p, P_DMAX, b)
+    rate = param(p, P_DRATE, b)
     dc = min(max(U[0, b], -dmax), dmax)
-    ddot = min(max((dc - X[IDELTA, b]) / p[P_TDELTA], -rate), rate)
+    ddot = min(max((dc - X[IDELTA, b]) / param(p, P_TDELTA, b), -rate), rate)
     sn, cs = sincos(X[IPSI, b])
     speed = X[IU, b]
     return (
         speed * cs + C[0, b],
         speed * sn + C[1, b],
         X[IR, b],
-        (p[P_KU] * U[1, b] - speed) / p[P_TU],
+        (param(p, P_KU, b) * U[1, b] - speed) / param(p, P_TU, b),
         ddot,
     )
 
@@ -298,7 +298,7 @@ def _store(K, b, xd, yd, psid, ud, ddot):
 def nomoto1_col(X, U, p, C, K, b):
     """First-order Nomoto derivative (seed 004 eq. 2) of ship ``b`` of a block."""
     xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
-    gain, T = p[P_YAW], p[P_YAW + 1]
+    gain, T = param(p, P_YAW, b), param(p, P_YAW + 1, b)
     rd = (gain * X[IDELTA, b] - X[IR, b]) / T
     _store(K, b, xd, yd, psid, ud, ddot)
     K[IR, b] = rd
@@ -308,8 +308,13 @@ def nomoto1_col(X, U, p, C, K, b):
 def norrbin_col(X, U, p, C, K, b):
     """Norrbin derivative (seed 002 eq. 1-3, seed 004 eq. 4) of ship ``b`` of a block."""
     xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
-    gain, T = p[P_YAW], p[P_YAW + 1]
-    n0, n1, n2, n3 = p[P_YAW + 2], p[P_YAW + 3], p[P_YAW + 4], p[P_YAW + 5]
+    gain, T = param(p, P_YAW, b), param(p, P_YAW + 1, b)
+    n0, n1, n2, n3 = (
+        param(p, P_YAW + 2, b),
+        param(p, P_YAW + 3, b),
+        param(p, P_YAW + 4, b),
+        param(p, P_YAW + 5, b),
+    )
     r = X[IR, b]
     hn = n3 * r * r * r + n2 * r * abs(r) + n1 * r + n0
     rd = (gain * X[IDELTA, b] - hn) / T
@@ -321,7 +326,12 @@ def norrbin_col(X, U, p, C, K, b):
 def nomoto2_col(X, U, p, C, K, b):
     """Second-order Nomoto derivative (seed 004 eq. 1) of ship ``b`` of a block."""
     xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
-    gain, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
+    gain, T1, T2, T3 = (
+        param(p, P_YAW, b),
+        param(p, P_YAW + 1, b),
+        param(p, P_YAW + 2, b),
+        param(p, P_YAW + 3, b),
+    )
     rdot = X[IRDOT, b]
     rdd = (gain * (X[IDELTA, b] + T3 * ddot) - (T1 + T2) * rdot - X[IR, b]) / (T1 * T2)
     _store(K, b, xd, yd, psid, ud, ddot)
@@ -333,8 +343,18 @@ def nomoto2_col(X, U, p, C, K, b):
 def bech_col(X, U, p, C, K, b):
     """Bech derivative (seed 004 eq. 3) of ship ``b`` of a block."""
     xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
-    gain, T1, T2, T3 = p[P_YAW], p[P_YAW + 1], p[P_YAW + 2], p[P_YAW + 3]
-    b0, b1, b2, b3 = p[P_YAW + 4], p[P_YAW + 5], p[P_YAW + 6], p[P_YAW + 7]
+    gain, T1, T2, T3 = (
+        param(p, P_YAW, b),
+        param(p, P_YAW + 1, b),
+        param(p, P_YAW + 2, b),
+        param(p, P_YAW + 3, b),
+    )
+    b0, b1, b2, b3 = (
+        param(p, P_YAW + 4, b),
+        param(p, P_YAW + 5, b),
+        param(p, P_YAW + 6, b),
+        param(p, P_YAW + 7, b),
+    )
     r = X[IR, b]
     rdot = X[IRDOT, b]
     hb = b3 * r * r * r + b2 * r * abs(r) + b1 * r + b0

@@ -35,7 +35,7 @@ attack limited at the stall angle, ``q`` the dynamic pressure over ``rho / 2`` w
 and, because it depends on ``v_p``, damps sway and yaw like a skeg (``dY/dv = -2 c_L u`` over both
 pods, three times the seed's linear sway damping at service speed). The propeller sees the
 inflow along the pod's axis, ``u_a = (1 - w)(u_p cos alpha + v_p sin alpha)``
-(:func:`pod_axial_inflow`). ``c_L = 0`` by default, which is seed 001's model. Fitted to the
+(:func:`pod_thrusts_col`). ``c_L = 0`` by default, which is seed 001's model. Fitted to the
 Kongsberg pod FMU table of MCSim_python (one pod, 47 points at 0-6.5 m/s, 150-220 rpm, 0-30 deg,
 v 0-2 m/s: ``POD_LIFT_COEFFICIENT_FMU``, ``POD_SLIPSTREAM_FMU``, ``D = 1.9`` m) the form
 reproduces the pod's surge and side forces to 2.9 and 2.3 kN RMS (forces up to 116 kN).
@@ -71,9 +71,10 @@ With zero thrust the relative-velocity dynamics are ``M nu_r' + (C_rb + C_a)(nu_
 D nu_r = 0`` for an irrotational current (Fossen 2011 property 8.1 holds for eq. 14), so with a
 symmetric ``M`` the kinetic energy relative to the water, ``nu_r^T M nu_r / 2``, never grows.
 
-The compiled per-ship functions here (:func:`rvg_col`, :func:`pod_thrust`, :func:`pod_thrusts`,
-:func:`pod_axial_inflow`) take their arrays unchecked: ``p`` must be :func:`pack_rvg`'s output
-and ``x`` a full state. From Python, :class:`shipgym.models.ShipModel` checks its arguments.
+The compiled per-ship functions here (:func:`rvg_col`, :func:`pod_thrust`,
+:func:`pod_thrusts_col`, :func:`pod_thrusts`) take their arrays unchecked: ``p`` must be
+:func:`pack_rvg`'s output (or a table of such columns) and ``X`` a block of full states. From
+Python, :class:`shipgym.models.ShipModel` checks its arguments.
 """
 
 from __future__ import annotations
@@ -83,7 +84,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from shipgym.models._jit import row_kernel, simd_kernel
+from shipgym.models._jit import param, row_kernel, simd_kernel
 from shipgym.models.kinematics import body_current
 from shipgym.models.vmath import sincos
 
@@ -464,39 +465,52 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     return p
 
 
-@row_kernel
-def pod_thrust(rpm, ur, p):
+@simd_kernel
+def pod_thrust(rpm, ur, p, b=0):
     """Propeller law: thrust [N] of one pod at shaft speed ``rpm`` and relative surge ``ur``.
 
     ``T = T_bollard (s^2 - s (1 - w) u_r / u_0)``, ``s = rpm / n_ref``, floored at 0 (module
-    docstring); ``ur`` is the inflow along the pod's axis (:func:`pod_axial_inflow`), which
-    straight ahead is the relative surge speed.
+    docstring); ``ur`` is the inflow along the pod's axis (:func:`pod_thrusts_col`), which straight
+    ahead is the relative surge speed. ``p`` and ``b`` as in :func:`rvg_col` (``p`` the packed
+    parameters, or a table with a column per ship, ``b`` the ship).
     """
-    s = abs(rpm) * p[P_INV_NREF]
-    return max(p[P_TBOLL] * (s * s - s * p[P_ADV] * ur * p[P_INV_U0]), 0.0)
+    s = abs(rpm) * param(p, P_INV_NREF, b)
+    adv = param(p, P_ADV, b)
+    return max(param(p, P_TBOLL, b) * (s * s - s * adv * ur * param(p, P_INV_U0, b)), 0.0)
 
 
-@row_kernel
-def pod_axial_inflow(x, c, p, k):
-    """Inflow [m/s] along the axis of pod ``k`` (before the wake fraction) for state ``x`` and
-    current ``c``: ``u_p cos alpha + v_p sin alpha`` (module docstring)."""
-    uc, vc = body_current(c, math.cos(x[IPSI]), math.sin(x[IPSI]))
-    ur = x[IU] - uc
-    vr = x[IV] - vc
-    a = x[IA1 + k]
-    up = ur - p[P_POD + 2 * k + 1] * x[IR]
-    vp = vr + p[P_POD + 2 * k] * x[IR]
-    return up * math.cos(a) + vp * math.sin(a)
+@simd_kernel
+def pod_thrusts_col(rpm, X, C, p, b):
+    """Thrusts [N] of both pods of ship ``b`` of a block (``X`` states x ships, ``C``
+    north/east current x ships, ``p`` as in :func:`rvg_col`) at shaft speed ``rpm``.
+
+    The propeller law :func:`pod_thrust` at each pod's axial inflow ``u_p cos alpha + v_p sin
+    alpha`` (module docstring), before the wake fraction. Straight-line code with the sine and
+    cosine of :mod:`shipgym.models.vmath`, so that a loop over the ships of a block compiles to
+    SIMD code.
+    """
+    sn, cs = sincos(X[IPSI, b])
+    uc, vc = body_current((C[0, b], C[1, b]), cs, sn)
+    ur = X[IU, b] - uc
+    vr = X[IV, b] - vc
+    r = X[IR, b]
+    sa1, ca1 = sincos(X[IA1, b])
+    sa2, ca2 = sincos(X[IA2, b])
+    in1 = (ur - param(p, P_POD + 1, b) * r) * ca1 + (vr + param(p, P_POD, b) * r) * sa1
+    in2 = (ur - param(p, P_POD + 3, b) * r) * ca2 + (vr + param(p, P_POD + 2, b) * r) * sa2
+    return pod_thrust(rpm, in1, p, b), pod_thrust(rpm, in2, p, b)
 
 
 @row_kernel
 def pod_thrusts(rpm, x, c, p):
-    """Thrusts [N] of both pods at shaft speed ``rpm``: the propeller law :func:`pod_thrust` at
-    each pod's axial inflow (:func:`pod_axial_inflow`) for state ``x`` and current ``c``."""
-    return (
-        pod_thrust(rpm, pod_axial_inflow(x, c, p, 0), p),
-        pod_thrust(rpm, pod_axial_inflow(x, c, p, 1), p),
-    )
+    """:func:`pod_thrusts_col` of one ship: state ``x`` (1-D), current ``c = (V_n, V_e)``."""
+    X = np.empty((x.shape[0], 1))
+    for j in range(x.shape[0]):
+        X[j, 0] = x[j]
+    C = np.empty((2, 1))
+    C[0, 0] = c[0]
+    C[1, 0] = c[1]
+    return pod_thrusts_col(rpm, X, C, p, 0)
 
 
 @simd_kernel
@@ -529,22 +543,27 @@ def rvg_col(X, U, p, C, K, b):
     sa2, ca2 = sincos(X[IA2, b])
     th1 = X[IT1, b]
     th2 = X[IT2, b]
-    x1, y1, x2, y2 = p[P_POD], p[P_POD + 1], p[P_POD + 2], p[P_POD + 3]
-    t1 = th1 * p[P_HULL_T]  # thrust on the hull, (1 - t) T
-    t2 = th2 * p[P_HULL_T]
+    x1, y1, x2, y2 = (
+        param(p, P_POD, b),
+        param(p, P_POD + 1, b),
+        param(p, P_POD + 2, b),
+        param(p, P_POD + 3, b),
+    )
+    t1 = th1 * param(p, P_HULL_T, b)  # thrust on the hull, (1 - t) T
+    t2 = th2 * param(p, P_HULL_T, b)
     fx = t1 * ca1 + t2 * ca2
     fy = t1 * sa1 + t2 * sa2
     fn = t1 * (-y1 * ca1 + x1 * sa1) + t2 * (-y2 * ca2 + x2 * sa2)
     # pod foil normal force from each pod's own inflow (module docstring; zero in seed 001)
-    lift, slip, sin_stall = p[P_LIFT], p[P_SLIP], p[P_SIN_STALL]
+    lift, slip, sin_stall = param(p, P_LIFT, b), param(p, P_SLIP, b), param(p, P_SIN_STALL, b)
     n1 = lift * _pod_normal(ur - y1 * r, vr + x1 * r, sa1, ca1, th1, slip, sin_stall)
     n2 = lift * _pod_normal(ur - y2 * r, vr + x2 * r, sa2, ca2, th2, slip, sin_stall)
     fx -= n1 * sa1 + n2 * sa2
     fy += n1 * ca1 + n2 * ca2
     fn += n1 * (x1 * ca1 + y1 * sa1) + n2 * (x2 * ca2 + y2 * sa2)
     # eq. (14): C_rb(nu) nu and C_a(nu_r) nu_r
-    m11, m22, m23 = p[P_MRB], p[P_MRB + 1], p[P_MRB + 2]
-    a11, a22, a23 = p[P_MA_C], p[P_MA_C + 1], p[P_MA_C + 2]
+    m11, m22, m23 = param(p, P_MRB, b), param(p, P_MRB + 1, b), param(p, P_MRB + 2, b)
+    a11, a22, a23 = param(p, P_MA_C, b), param(p, P_MA_C + 1, b), param(p, P_MA_C + 2, b)
     c_rb0 = -(m22 * vv + m23 * r) * r
     c_rb1 = m11 * uu * r
     c_rb2 = (m22 * vv + m23 * r) * uu - m11 * uu * vv
@@ -552,37 +571,54 @@ def rvg_col(X, U, p, C, K, b):
     c_a1 = a11 * ur * r
     c_a2 = (a22 * vr + a23 * r) * ur - a11 * ur * vr
     # eq. (15): D(nu_r) nu_r
-    d0 = p[P_DL] * ur + p[P_DL + 1] * vr + p[P_DL + 2] * r + p[P_DQ] * abs(ur) * ur
-    d1 = p[P_DL + 3] * ur + p[P_DL + 4] * vr + p[P_DL + 5] * r + p[P_DQ + 1] * abs(vr) * vr
-    d2 = p[P_DL + 6] * ur + p[P_DL + 7] * vr + p[P_DL + 8] * r + p[P_DQ + 2] * abs(r) * r
+    d0 = (
+        param(p, P_DL, b) * ur
+        + param(p, P_DL + 1, b) * vr
+        + param(p, P_DL + 2, b) * r
+        + param(p, P_DQ, b) * abs(ur) * ur
+    )
+    d1 = (
+        param(p, P_DL + 3, b) * ur
+        + param(p, P_DL + 4, b) * vr
+        + param(p, P_DL + 5, b) * r
+        + param(p, P_DQ + 1, b) * abs(vr) * vr
+    )
+    d2 = (
+        param(p, P_DL + 6, b) * ur
+        + param(p, P_DL + 7, b) * vr
+        + param(p, P_DL + 8, b) * r
+        + param(p, P_DQ + 2, b) * abs(r) * r
+    )
     # turning speed loss X_vv v^2 + X_vr v r + X_rr r^2 (zero in seed 001)
-    d0 -= p[P_XVV] * vr * vr + p[P_XVR] * vr * r + p[P_XRR] * r * r
+    d0 -= param(p, P_XVV, b) * vr * vr + param(p, P_XVR, b) * vr * r + param(p, P_XRR, b) * r * r
     # wave-making resistance c_w Fn^2 rho/2 S |u_r| u_r (zero in seed 001)
-    d0 += p[P_XW] * ur * ur * abs(ur) * ur
+    d0 += param(p, P_XW, b) * ur * ur * abs(ur) * ur
     # sway-yaw cross terms of the cross-flow drag integral (zero in seed 001)
     # the sway-yaw cross terms of the cross-flow drag: rvg_crossflow_col, when not zero
     # eq. (9): nu_c' = [r v_c, -r u_c, 0]; M_a nu_c'
     ncd0 = r * vc
     ncd1 = -r * uc
-    ma0 = p[P_MA] * ncd0 + p[P_MA + 1] * ncd1
-    ma1 = p[P_MA + 3] * ncd0 + p[P_MA + 4] * ncd1
-    ma2 = p[P_MA + 6] * ncd0 + p[P_MA + 7] * ncd1
+    ma0 = param(p, P_MA, b) * ncd0 + param(p, P_MA + 1, b) * ncd1
+    ma1 = param(p, P_MA + 3, b) * ncd0 + param(p, P_MA + 4, b) * ncd1
+    ma2 = param(p, P_MA + 6, b) * ncd0 + param(p, P_MA + 7, b) * ncd1
     # eq. (12)
     b0 = fx - c_rb0 - c_a0 - d0 + ma0
     b1 = fy - c_rb1 - c_a1 - d1 + ma1
     b2 = fn - c_rb2 - c_a2 - d2 + ma2
-    du = p[P_MINV] * b0 + p[P_MINV + 1] * b1 + p[P_MINV + 2] * b2
-    dv = p[P_MINV + 3] * b0 + p[P_MINV + 4] * b1 + p[P_MINV + 5] * b2
-    dr = p[P_MINV + 6] * b0 + p[P_MINV + 7] * b1 + p[P_MINV + 8] * b2
+    du = param(p, P_MINV, b) * b0 + param(p, P_MINV + 1, b) * b1 + param(p, P_MINV + 2, b) * b2
+    dv = param(p, P_MINV + 3, b) * b0 + param(p, P_MINV + 4, b) * b1 + param(p, P_MINV + 5, b) * b2
+    dr = param(p, P_MINV + 6, b) * b0 + param(p, P_MINV + 7, b) * b1 + param(p, P_MINV + 8, b) * b2
     # first-order pod thrust and azimuth dynamics with limits (eq. 18)
-    tmax = p[P_TBOLL] * min(max(1.0 - p[P_ADV] * ur * p[P_INV_U0], 0.0), 1.0)
-    amax = p[P_AMAX]
-    rate = p[P_ARATE]
-    inv_tau_t = p[P_INV_TAU_T]
-    inv_tau_a = p[P_INV_TAU_A]
+    tmax = param(p, P_TBOLL, b) * min(
+        max(1.0 - param(p, P_ADV, b) * ur * param(p, P_INV_U0, b), 0.0), 1.0
+    )
+    amax = param(p, P_AMAX, b)
+    rate = param(p, P_ARATE, b)
+    inv_tau_t = param(p, P_INV_TAU_T, b)
+    inv_tau_a = param(p, P_INV_TAU_A, b)
     dt1 = (min(max(U[0, b], 0.0), tmax) - th1) * inv_tau_t
     dt2 = (min(max(U[1, b], 0.0), tmax) - th2) * inv_tau_t
-    aoff = p[P_AOFF]  # the pods turn to the order plus their offset
+    aoff = param(p, P_AOFF, b)  # the pods turn to the order plus their offset
     da1 = min(max((min(max(U[2, b], -amax), amax) + aoff - X[IA1, b]) * inv_tau_a, -rate), rate)
     da2 = min(max((min(max(U[3, b], -amax), amax) + aoff - X[IA2, b]) * inv_tau_a, -rate), rate)
     # every write after every read (the loop over the ships then compiles to SIMD code)
@@ -643,17 +679,17 @@ def rvg_crossflow_col(X, p, C, K, b):
     cf_n = 0.0
     vq = abs(vr) * vr
     for j in range(P_CF_W - P_CF_X):
-        xs = p[P_CF_X + j]
+        xs = param(p, P_CF_X + j, b)
         xr = xs * r
         s = vr + xr
-        f = (abs(s) * s - vq - abs(xr) * xr) * p[P_CF_W + j]
+        f = (abs(s) * s - vq - abs(xr) * xr) * param(p, P_CF_W + j, b)
         cf_y += f
         cf_n += f * xs
-    dy = p[P_CF] * cf_y
-    dn = p[P_CF] * cf_n
-    du = p[P_MINV + 1] * dy + p[P_MINV + 2] * dn
-    dv = p[P_MINV + 4] * dy + p[P_MINV + 5] * dn
-    dr = p[P_MINV + 7] * dy + p[P_MINV + 8] * dn
+    dy = param(p, P_CF, b) * cf_y
+    dn = param(p, P_CF, b) * cf_n
+    du = param(p, P_MINV + 1, b) * dy + param(p, P_MINV + 2, b) * dn
+    dv = param(p, P_MINV + 4, b) * dy + param(p, P_MINV + 5, b) * dn
+    dr = param(p, P_MINV + 7, b) * dy + param(p, P_MINV + 8, b) * dn
     K[IU, b] -= du
     K[IV, b] -= dv
     K[IR, b] -= dr

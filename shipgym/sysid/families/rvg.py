@@ -4,8 +4,8 @@ The base model is the RVG 3-DOF model of seed 001 (eq. 5-20, :mod:`shipgym.model
 as on the sea trials by the recorded **orders**: the azimuth order of both pods (raw pod sign,
 positive turns to port; the record's ``azimuth``, or ``-delta``) and the rpm order, turned into a
 thrust command at every step by the propeller law at each pod's simulated axial inflow
-(:func:`shipgym.models.rvg.pod_thrusts`). The pods follow both through the model's first-order
-actuators.
+(:func:`shipgym.models.rvg.pod_thrusts_col`). The pods follow both through the model's
+first-order actuators.
 
 Replay
 ------
@@ -89,7 +89,7 @@ geometric mean of five channels by 7 %.)
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -98,8 +98,8 @@ from scipy.optimize import least_squares
 from scipy.signal import savgol_filter
 
 from shipgym.models import RVGParams
-from shipgym.models._jit import kernel
-from shipgym.models.integrate import RVG3DOF, rk4_block
+from shipgym.models._jit import kernel, row_kernel
+from shipgym.models.integrate import RVG3DOF, SIMD_LANES, rk4_block
 from shipgym.models.model_file import rvg_document
 from shipgym.models.rvg import (
     DRAUGHT,
@@ -115,8 +115,9 @@ from shipgym.models.rvg import (
     YAW_QUADRATIC_DAMPING,
     YAW_QUADRATIC_DAMPING_CROSSFLOW,
     pack_rvg,
-    pod_thrusts,
+    pod_thrusts_col,
 )
+from shipgym.sysid.batched import SideBySide
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
     Candidate,
@@ -371,40 +372,88 @@ def apply_values(base: RVGParams, values: Mapping[str, float]) -> RVGParams:
 # windowed replay
 
 
-@kernel
-def _windows_kernel(t, meas, rpm, az, starts, p, c, alpha0, v0, out):  # pragma: no cover - jit
+@row_kernel
+def _windows(width, t, meas, rpm, az, starts, P, C, alpha0, v0, out):  # pragma: no cover - jit
+    """The windowed replay of ``width`` variants of the model side by side, the ships of one
+    block (:func:`_windows_kernel`)."""
     n = t.shape[0]
     m = starts.shape[0]
-    x = np.empty((10, 1))  # a block of one ship (states x ships)
-    u = np.empty((4, 1))
-    cc = np.empty((2, 1))
-    cc[0, 0] = c[0]
-    cc[1, 0] = c[1]
-    work = np.empty((3, 10, 1))
-    amax = p[P_AMAX]
+    x = np.empty((10, width))  # the variants as a block of ships (states x ships)
+    u = np.empty((4, width))
+    work = np.empty((3, 10, width))
     for w in range(m):
         i0 = starts[w]
         i1 = starts[w + 1] if w + 1 < m else n
-        for j in range(6):
-            x[j, 0] = meas[i0, j]
-        x[4, 0] -= v0
-        if w == 0:  # pods at the first orders; later windows keep the simulated pod states
-            a = min(max(az[i0] + alpha0, -amax), amax)
-            x[IA1, 0] = a
-            x[IA2, 0] = a
-            x[IT1, 0], x[IT2, 0] = pod_thrusts(rpm[i0], x[:, 0], c, p)
-        for j in range(10):
-            out[i0, j] = x[j, 0]
-        out[i0, 4] += v0
-        for k in range(i0, i1 - 1):
-            u[0, 0], u[1, 0] = pod_thrusts(rpm[k], x[:, 0], c, p)
-            u[2, 0] = az[k] + alpha0
-            u[3, 0] = az[k] + alpha0
-            h = t[k + 1] - t[k]
-            rk4_block(RVG3DOF, x, u, p, cc, h, 1, work)
+        for b in range(width):
+            for j in range(6):
+                x[j, b] = meas[i0, j]
+            x[4, b] -= v0[b]
+            if w == 0:  # pods at the first orders; later windows keep the simulated pod states
+                amax = P[P_AMAX, b]
+                a = min(max(az[i0] + alpha0[b], -amax), amax)
+                x[IA1, b] = a
+                x[IA2, b] = a
+                x[IT1, b], x[IT2, b] = pod_thrusts_col(rpm[i0], x, C, P, b)
             for j in range(10):
-                out[k + 1, j] = x[j, 0]
-            out[k + 1, 4] += v0  # the recorded (offset) transverse speed
+                out[i0, b, j] = x[j, b]
+            out[i0, b, 4] += v0[b]
+        for k in range(i0, i1 - 1):
+            for b in range(width):
+                u[0, b], u[1, b] = pod_thrusts_col(rpm[k], x, C, P, b)
+                u[2, b] = az[k] + alpha0[b]
+                u[3, b] = az[k] + alpha0[b]
+            rk4_block(RVG3DOF, x, u, P, C, t[k + 1] - t[k], width, work)
+            for b in range(width):
+                for j in range(10):
+                    out[k + 1, b, j] = x[j, b]
+                out[k + 1, b, 4] += v0[b]  # the recorded (offset) transverse speed
+
+
+@kernel
+def _windows_kernel(t, meas, rpm, az, starts, P, C, alpha0, v0, out):  # pragma: no cover - jit
+    """Replay a record window by window with ``P.shape[1]`` variants of the model: column ``b``
+    of the parameter table ``P`` and of the current ``C``, ``alpha0[b]`` and ``v0[b]`` give
+    variant ``b``, whose states go to ``out[:, b]``. One variant is stepped as a block of one
+    (its width a compile-time constant), several as one block whose loops over the variants
+    compile to SIMD code."""
+    if P.shape[1] == 1:
+        _windows(1, t, meas, rpm, az, starts, P, C, alpha0, v0, out)
+    else:
+        _windows(P.shape[1], t, meas, rpm, az, starts, P, C, alpha0, v0, out)
+
+
+def _replay(
+    time: np.ndarray,
+    meas: np.ndarray,
+    rpm: np.ndarray,
+    az: np.ndarray,
+    starts: np.ndarray,
+    packed: Sequence[np.ndarray],
+    current: Sequence[tuple[float, float]],
+    alpha_0: Sequence[float],
+    v_0: Sequence[float],
+) -> np.ndarray:
+    """States ``(n, variants, 10)`` of :func:`_windows_kernel` for the variants given by their
+    packed parameters (``pack_rvg``), currents ``(V_n, V_e)``, azimuth offsets and transverse
+    speed offsets, one entry each per variant.
+
+    Several variants are padded with copies of the last to a multiple of
+    :data:`~shipgym.models.integrate.SIMD_LANES`: the loops over them then run in whole SIMD
+    vectors, where a remainder would run one variant at a time.
+    """
+    n_var = len(packed)
+    width = n_var if n_var == 1 else -(-n_var // SIMD_LANES) * SIMD_LANES
+    pick = np.minimum(np.arange(width), n_var - 1)
+    P = np.ascontiguousarray(np.column_stack(packed)[:, pick])
+    P.flags.writeable = False
+    out = np.empty((time.size, width, 10))
+    _windows_kernel(
+        time, meas, rpm, az, np.asarray(starts, dtype=np.int64), P,
+        np.ascontiguousarray(np.asarray(current, dtype=np.float64)[pick].T),
+        np.asarray(alpha_0, dtype=np.float64)[pick], np.asarray(v_0, dtype=np.float64)[pick],
+        out,
+    )  # fmt: skip
+    return out[:, :n_var]
 
 
 def measured_states(record: Record) -> np.ndarray:
@@ -477,20 +526,10 @@ def replay_windows(
         ``(n, 10)`` simulated states (``rvg.RVG_STATES``), ``v`` as recorded (``+ v_0``).
     """
     check_record(record)
-    out = np.empty((record.time.size, 10))
-    _windows_kernel(
-        record.time,
-        start_states(record),
-        record.rpm,
-        azimuth_orders(record),
-        np.asarray(starts, dtype=np.int64),
-        pack_rvg(params),
-        np.asarray(current, dtype=np.float64),
-        float(alpha_0),
-        float(v_0),
-        out,
-    )
-    return out
+    return _replay(
+        record.time, start_states(record), record.rpm, azimuth_orders(record), starts,
+        [pack_rvg(params)], [current], [float(alpha_0)], [float(v_0)],
+    )[:, 0]  # fmt: skip
 
 
 def simulate_orders(
@@ -528,21 +567,12 @@ def simulate_orders(
     x0 = np.asarray(x0, dtype=np.float64)
     if x0.shape != (6,) or not np.all(np.isfinite(x0)):
         raise ValueError(f"x0 must be 6 finite numbers [x, y, psi, u, v, r], got {x0!r}")
-    meas = np.tile(x0, (n, 1))
-    out = np.empty((n, 10))
-    _windows_kernel(
-        t,
-        meas,
-        np.asarray(rpm, dtype=np.float64),
-        np.asarray(azimuth, dtype=np.float64),
-        np.array([0], dtype=np.int64),
-        pack_rvg(params),
-        np.asarray(current, dtype=np.float64),
-        float(alpha_0),
-        0.0,
-        out,
-    )
-    return out[:, :6]
+    out = _replay(
+        t, np.tile(x0, (n, 1)), np.asarray(rpm, dtype=np.float64),
+        np.asarray(azimuth, dtype=np.float64), np.array([0]), [pack_rvg(params)], [current],
+        [float(alpha_0)], [0.0],
+    )  # fmt: skip
+    return out[:, 0, :6]
 
 
 # --------------------------------------------------------------------------------------------
@@ -592,19 +622,47 @@ class RVGFit:
         )
 
 
+_CHANNEL_COLUMNS = (2, 5, 3, 4, 0, 1)  # psi, r, u, v, x, y: the same in states and measurements
+
+
+@kernel
+def _residual_kernel(sims, meas, rows, sigma, out):  # pragma: no cover - jit
+    m = rows.shape[0]
+    finite = np.ones(sims.shape[1], dtype=np.bool_)
+    for i in range(m):  # sample by sample: each sample's replays lie side by side in memory
+        k = rows[i]
+        for b in range(sims.shape[1]):
+            for ch in range(6):
+                c = _CHANNEL_COLUMNS[ch]
+                e = sims[k, b, c] - meas[k, c]
+                if ch == 0:
+                    e = (e + math.pi) % (2.0 * math.pi) - math.pi
+                v = e / sigma[ch]
+                out[b, ch * m + i] = v
+                finite[b] = finite[b] and math.isfinite(v)
+    for b in range(sims.shape[1]):
+        if not finite[b]:
+            out[b, :] = 1e6
+
+
+def _residuals_of(
+    sims: np.ndarray, meas: np.ndarray, mask: np.ndarray, sigma: tuple[float, ...]
+) -> np.ndarray:
+    """Weighted residuals ``(variants, 6 m)`` of the replays ``sims`` (``(n, variants, 10)``,
+    :func:`_replay`) over the ``m`` samples in ``mask``: for each variant the channels psi
+    (wrapped), r, u, v, x, y one after the other, each divided by its ``sigma``; all ``1e6``
+    for a variant with a non-finite residual."""
+    rows = np.flatnonzero(mask)
+    out = np.empty((sims.shape[1], 6 * rows.size))
+    _residual_kernel(sims, meas, rows, np.asarray(sigma, dtype=np.float64), out)
+    return out
+
+
 def _residuals(
     sim: np.ndarray, meas: np.ndarray, mask: np.ndarray, sigma: tuple[float, ...]
 ) -> np.ndarray:
-    """Weighted residuals of the channels over the samples in ``mask``."""
-    parts = []
-    # psi, r, u, v, x, y: the same columns in the state and the measured layouts
-    for ch, c in enumerate((2, 5, 3, 4, 0, 1)):
-        e = sim[mask, c] - meas[mask, c]
-        if ch == 0:
-            e = (e + np.pi) % (2.0 * np.pi) - np.pi
-        parts.append(e / sigma[ch])
-    out = np.concatenate(parts)
-    return out if np.all(np.isfinite(out)) else np.full(out.shape, 1e6)
+    """:func:`_residuals_of` one replay ``sim`` (``(n, 10)``)."""
+    return _residuals_of(sim[:, None], meas, mask, sigma)[0]
 
 
 def fit_rvg(
@@ -682,21 +740,24 @@ def fit_rvg(
     az = azimuth_orders(record)[keep]
     time_, rpm = record.time[keep], record.rpm[keep]
     mask = np.asarray(mask, dtype=bool)[keep]
-    out = np.empty((time_.size, 10))
     starts64 = np.unique(np.asarray(starts, dtype=np.int64) // stride)
     has_v = record.v is not None
 
     def unpack(th: np.ndarray) -> dict[str, float]:
         return {f.name: f.from_theta(float(v)) for f, v in zip(free, th, strict=True)}
 
-    def simulate(th: np.ndarray) -> np.ndarray:
-        vals = unpack(th)
-        _windows_kernel(
-            time_, start, rpm, az, starts64, pack_rvg(apply_values(base, vals)),
-            np.array([vals.get("V_n", 0.0), vals.get("V_e", 0.0)]), vals.get("alpha_0", 0.0),
-            vals.get("v_0", 0.0), out,
+    def variants(thetas: np.ndarray) -> np.ndarray:
+        """Replays ``(n, len(thetas), 10)`` of the model at each row of ``thetas``, side by
+        side."""
+        vals = [unpack(th) for th in thetas]
+        return _replay(
+            time_, start, rpm, az, starts64, [pack_rvg(apply_values(base, v)) for v in vals],
+            [(v.get("V_n", 0.0), v.get("V_e", 0.0)) for v in vals],
+            [v.get("alpha_0", 0.0) for v in vals], [v.get("v_0", 0.0) for v in vals],
         )  # fmt: skip
-        return out
+
+    def simulate(th: np.ndarray) -> np.ndarray:
+        return variants(th[None, :])[:, 0]
 
     sigma = list(init.sigma if init is not None else _FIRST_PASS_SIGMA)
     if not has_v:
@@ -714,6 +775,7 @@ def fit_rvg(
                 max_nfev=max_nfev,
                 ftol=FIT_TOL[0],
                 xtol=FIT_TOL[1],
+                workers=SideBySide(lambda ths, s=sig: _residuals_of(variants(ths), meas, mask, s)),
             )
         theta0 = sol.x
         sim = simulate(sol.x)
