@@ -399,7 +399,15 @@ def test_benchmark_table_and_plot(tmp_path: Path) -> None:
             },
         ],
     }
+    rep["replays"] = [
+        {
+            "name": "rvg3dof, Gunnerus sea trials", "samples": 17701, "columns": 8,
+            "one_at_a_time_s": [1.0, 1.2, 0.9], "side_by_side_s": [0.25, 0.4, 0.3],
+            "speedup": 3.0,
+        }
+    ]  # fmt: skip
     table = format_benchmark(rep)
+    assert "| rvg3dof, Gunnerus sea trials | 17701 | 8 | 1.000 | 0.300 | 3.00 x |" in table
     assert "| nomoto1 output-error fit | 10001 | 0.450 | 3 | 1 | 0.450 | met |" in table
     assert "| identify loop | 10001 | 25.000 | 1 | 10 | 2.500 | missed |" in table
     assert "skipped: no rvg3dof family registered" in table
@@ -419,6 +427,14 @@ def test_benchmark_sysid_smoke() -> None:
     assert gunnerus["median_s"] is None and gunnerus["skipped"] == "no measured-data root given"
     assert rep["config"]["duration_s"] == 20.0
     assert any(m.startswith("fit ") and "goal 1 s" in m for m in lines)
+    nomoto, rvg = rep["replays"]
+    assert (nomoto["columns"], rvg["columns"]) == (4, 8)
+    assert rvg["name"] == "rvg3dof, generated record"  # no measured-data root
+    for r in (nomoto, rvg):
+        assert len(r["one_at_a_time_s"]) == len(r["side_by_side_s"]) == 5
+        ratios = [a / b for a, b in zip(r["one_at_a_time_s"], r["side_by_side_s"], strict=True)]
+        assert r["speedup"] == pytest.approx(sorted(ratios)[2])
+    assert sum(m.startswith("replays ") for m in lines) == 10
     json.dumps(rep)
 
 

@@ -18,7 +18,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SideBySide"]
+from shipgym.models.integrate import SIMD_LANES
+
+__all__ = ["SideBySide", "lanes"]
 
 
 class SideBySide:
@@ -39,3 +41,12 @@ class SideBySide:
 
     def __call__(self, fun: Any, points: Iterable[np.ndarray]) -> list[np.ndarray]:
         return list(self._residuals(np.array(list(points), dtype=np.float64)))
+
+
+def lanes(variants: int) -> np.ndarray:
+    """Which variant each ship of a block replays: ``0 .. variants - 1``, and for several
+    variants the last again up to a multiple of
+    :data:`~shipgym.models.integrate.SIMD_LANES`, so that the loops over the ships run in whole
+    SIMD vectors (a remainder would run one ship at a time). One variant is a block of one."""
+    width = variants if variants == 1 else -(-variants // SIMD_LANES) * SIMD_LANES
+    return np.minimum(np.arange(width), variants - 1)

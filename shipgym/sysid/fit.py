@@ -90,6 +90,7 @@ from shipgym.models.base import MODEL_NAMES
 from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
 from shipgym.models.model_file import with_rudder_offset
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
+from shipgym.sysid.batched import SideBySide, lanes
 
 __all__ = [
     "FIT_MODELS",
@@ -383,24 +384,37 @@ class FitResult:
 
 
 @row_kernel
-def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
-    nx = x0.shape[0]
-    x = np.empty((nx, 1))  # a block of one ship (states x ships)
-    for j in range(nx):
-        x[j, 0] = x0[j]
-    u = np.zeros((2, 1))
-    c = np.zeros((2, 1))
-    work = np.empty((3, nx, 1))
-    for j in range(nx):
-        out[0, j] = x[j, 0]
-    for k in range(h.shape[0]):
-        x[IDELTA, 0] = delta[k]
-        x[IU, 0] = speed[k]
-        u[0, 0] = dc[k]
-        u[1, 0] = n_cmd[k]
-        rk4_block(model_id, x, u, p, c, h[k], 1, work)
+def _replay_loop(model_id, width, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
+    nx = X0.shape[0]
+    x = np.empty((nx, width))  # the variants as a block of ships (states x ships)
+    u = np.zeros((2, width))
+    c = np.zeros((2, width))
+    work = np.empty((3, nx, width))
+    for b in range(width):
         for j in range(nx):
-            out[k + 1, j] = x[j, 0]
+            x[j, b] = X0[j, b]
+            out[0, b, j] = x[j, b]
+    for k in range(h.shape[0]):
+        for b in range(width):
+            dl = delta[k] + d0[b]
+            x[IDELTA, b] = dl
+            x[IU, b] = speed[k]
+            u[0, b] = dl + _REPLAY_TC * ((delta[k + 1] + d0[b]) - dl) / h[k]
+            u[1, b] = n_cmd[k]
+        rk4_block(model_id, x, u, P, c, h[k], width, work)
+        for b in range(width):
+            for j in range(nx):
+                out[k + 1, b, j] = x[j, b]
+
+
+@row_kernel
+def _replay_variants(model_id, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
+    """One variant as a block of one (its width a compile-time constant), several as one
+    block whose loops over the variants compile to SIMD code."""
+    if P.shape[1] == 1:
+        _replay_loop(model_id, 1, X0, delta, d0, speed, n_cmd, h, P, out)
+    else:
+        _replay_loop(model_id, P.shape[1], X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 # One compilation of the loop per model: with the model id a compile-time constant the model
@@ -408,23 +422,23 @@ def _replay_loop(model_id, x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: n
 # with the id as a run-time argument (same arithmetic, identical results). Each is compiled
 # on first use.
 @kernel
-def _replay_nomoto1(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
-    _replay_loop(NOMOTO1, x0, delta, dc, speed, n_cmd, h, p, out)
+def _replay_nomoto1(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
+    _replay_variants(NOMOTO1, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
-def _replay_nomoto2(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
-    _replay_loop(NOMOTO2, x0, delta, dc, speed, n_cmd, h, p, out)
+def _replay_nomoto2(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
+    _replay_variants(NOMOTO2, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
-def _replay_norrbin(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
-    _replay_loop(NORRBIN, x0, delta, dc, speed, n_cmd, h, p, out)
+def _replay_norrbin(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
+    _replay_variants(NORRBIN, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
-def _replay_bech(x0, delta, dc, speed, n_cmd, h, p, out):  # pragma: no cover - jit
-    _replay_loop(BECH, x0, delta, dc, speed, n_cmd, h, p, out)
+def _replay_bech(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
+    _replay_variants(BECH, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 _REPLAY_KERNELS = {
@@ -437,22 +451,33 @@ _REPLAY_KERNELS = {
 
 def _replay_kernel(
     model_id: int,
-    x0: np.ndarray,
+    x0: Sequence[np.ndarray],
     delta: np.ndarray,
-    dc: np.ndarray,
+    d0: Sequence[float],
     speed: np.ndarray,
     n_cmd: np.ndarray,
     h: np.ndarray,
-    p: np.ndarray,
-    out: np.ndarray,
-) -> None:
-    """Replay ``delta`` from ``x0`` with the model ``model_id``, writing the states to ``out``.
+    p: Sequence[np.ndarray],
+    t_len: int,
+) -> np.ndarray:
+    """Replay the rudder ``delta`` with variants of the model ``model_id``: variant ``b``
+    starts from ``x0[b]``, has the packed parameters ``p[b]`` and the rudder offset ``d0[b]``.
+    Returns the states ``(t_len, variants, nx)``.
 
-    At step ``k`` the rudder and speed states are set to ``delta[k]``, ``speed[k]`` and the
-    commands to ``dc[k]``, ``n_cmd[k]`` (see the module docstring), then one RK4 step of
-    ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_block`.
+    At step ``k`` the rudder and speed states are set to ``delta[k] + d0``, ``speed[k]`` and
+    the commands to the rudder's first-order lead ``dc`` and ``n_cmd[k]`` (module docstring),
+    then one RK4 step of ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_block`, all
+    the variants as the ships of one block (padded to whole SIMD vectors,
+    :func:`shipgym.sysid.batched.lanes`).
     """
-    _REPLAY_KERNELS[model_id](x0, delta, dc, speed, n_cmd, h, p, out)
+    pick = lanes(len(p))
+    P = np.ascontiguousarray(np.column_stack(p)[:, pick])
+    P.flags.writeable = False
+    X0 = np.ascontiguousarray(np.column_stack(x0)[:, pick])
+    out = np.empty((t_len, pick.size, X0.shape[0]))
+    d0s = np.asarray(d0, dtype=np.float64)[pick]
+    _REPLAY_KERNELS[model_id](X0, delta, d0s, speed, n_cmd, h, P, out)
+    return out[:, : len(p)]
 
 
 def _replay_inputs(
@@ -516,10 +541,8 @@ def _replay_arrays(
     delta: np.ndarray,
     speed: np.ndarray,
 ) -> np.ndarray:
-    h, dc, n_cmd = _replay_inputs(t, delta, speed)
-    out = np.empty((t.shape[0], x0.shape[0]))
-    _replay_kernel(model_id, x0, delta, dc, speed, n_cmd, h, p, out)
-    return out
+    h, _, n_cmd = _replay_inputs(t, delta, speed)
+    return _replay_kernel(model_id, [x0], delta, [0.0], speed, n_cmd, h, [p], t.shape[0])[:, 0]
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
@@ -1145,19 +1168,22 @@ def fit_output_error(
         return vals, x, d0
 
     h, _, n_cmd = _replay_inputs(t, delta, speed)
-    out = np.empty((n, nx))
     # actuator/surge head of the parameter vector (layout owned by ``pack_nomoto``); the yaw
     # coefficients follow, unvalidated, since the optimiser may probe any values
     head = pack_nomoto(cls(), _REPLAY_GEAR, _REPLAY_SURGE)[:P_YAW]
 
+    def variants(thetas: np.ndarray) -> np.ndarray:
+        """Replays ``(n, len(thetas), nx)`` of the model at each row of ``thetas``, side by
+        side."""
+        parts = [unpack(theta) for theta in thetas]
+        packed = [np.concatenate((head, [v[f.name] for f in fields(cls)])) for v, _, _ in parts]
+        return _replay_kernel(
+            model_id, [x for _, x, _ in parts], delta, [d0 for _, _, d0 in parts], speed,
+            n_cmd, h, packed, n,
+        )  # fmt: skip
+
     def simulate(theta: np.ndarray) -> np.ndarray:
-        vals, x, d0 = unpack(theta)
-        p = np.concatenate((head, [vals[f.name] for f in fields(cls)]))
-        p.flags.writeable = False
-        dl = delta + d0
-        dc = dl[:-1] + _REPLAY_TC * np.diff(dl) / h
-        _replay_kernel(model_id, x, dl, dc, speed, n_cmd, h, p, out)
-        return out
+        return variants(theta[None, :])[:, 0]
 
     w = (
         [1.0 / s for s in sigma]
@@ -1165,17 +1191,29 @@ def fit_output_error(
         else [1.0 / max(float(np.std(psi)), 1e-6), 1.0 / max(float(np.std(r)), 1e-9)]
     )
 
-    def residuals(theta: np.ndarray) -> np.ndarray:
-        sim = simulate(theta)
-        res = np.concatenate((w[0] * _wrap(sim[:, IPSI] - psi), w[1] * (sim[:, IR] - r)))
-        if not np.all(np.isfinite(res)):
-            return np.full(2 * n, 1e6)
+    def residuals_of(thetas: np.ndarray) -> np.ndarray:
+        """Residuals ``(len(thetas), 2 n)``: weighted heading then yaw-rate errors, all
+        ``1e6`` for a variant with a non-finite one."""
+        sims = variants(thetas)
+        with np.errstate(invalid="ignore", over="ignore"):  # a diverged replay: 1e6 below
+            res = np.concatenate(
+                (
+                    w[0] * _wrap(sims[:, :, IPSI] - psi[:, None]),
+                    w[1] * (sims[:, :, IR] - r[:, None]),
+                )
+            ).T.copy()
+        res[~np.isfinite(res).all(axis=1)] = 1e6
         return res
 
+    def residuals(theta: np.ndarray) -> np.ndarray:
+        return residuals_of(theta[None, :])[0]
+
     bounds = (lower, np.full(len(names), np.inf))
+    side_by_side = SideBySide(residuals_of)
     sol = least_squares(
-        residuals, theta0, bounds=bounds, x_scale="jac", method="trf", max_nfev=max_nfev
-    )
+        residuals, theta0, bounds=bounds, x_scale="jac", method="trf", max_nfev=max_nfev,
+        workers=side_by_side,
+    )  # fmt: skip
     nfev = sol.nfev
     if sigma is None and reweight:
         sim = simulate(sol.x)
@@ -1183,8 +1221,9 @@ def fit_output_error(
         s_r = float(np.sqrt(np.mean((sim[:, IR] - r) ** 2)))
         w = [1.0 / max(s_psi, 1e-12), 1.0 / max(s_r, 1e-15)]
         sol = least_squares(
-            residuals, sol.x, bounds=bounds, x_scale="jac", method="trf", max_nfev=max_nfev
-        )
+            residuals, sol.x, bounds=bounds, x_scale="jac", method="trf", max_nfev=max_nfev,
+            workers=side_by_side,
+        )  # fmt: skip
         nfev += sol.nfev
     J = sol.jac
     dof = max(2 * n - len(names), 1)

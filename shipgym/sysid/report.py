@@ -45,7 +45,7 @@ import numpy as np
 
 from shipgym.sysid.data import ProgressArg, Record, load, load_all, progress_printer
 from shipgym.sysid.engine import IdentificationResult, identify
-from shipgym.sysid.families.base import FAMILIES
+from shipgym.sysid.families.base import FAMILIES, window_starts
 
 __all__ = [
     "BENCH_GOALS",
@@ -1118,7 +1118,13 @@ def benchmark_sysid(
         for name, n, times, details in _bench_hsva(folder, repeats, say):
             add(name, descs[name], n, times, **details)
 
+    # 5. a Jacobian's replays one at a time and side by side, in interleaved rounds
+    replays = _bench_replays(
+        None if path is None or not path.is_file() else path, duration, seed, max(repeats, 5), say
+    )
+
     return {
+        "replays": replays,
         "config": {
             "repeats": repeats,
             "effect": effect,
@@ -1157,6 +1163,82 @@ def _bench_hsva(
         ("hsva_regression", n, reg_times, {}),
         ("hsva_loop", n, loop_times, {"effects_found": res.effect_names}),
     ]
+
+
+def _bench_replays(
+    gunnerus: Path | None, duration: float, seed: int, rounds: int, say: Callable[[str], None]
+) -> list[dict[str, Any]]:
+    """The replays of one finite-difference Jacobian (one per free parameter), one at a time and
+    side by side as the ships of one block (:mod:`shipgym.sysid.batched`), timed in
+    ``rounds`` interleaved rounds: ``nomoto1`` on a generated random-rudder record (4 columns)
+    and ``rvg3dof`` window by window on the Gunnerus sea trials (a generated record without
+    them; 8 columns, the base fit's 6 and two effects). The speed-up is the median over the
+    rounds of the ratio of the two times measured in the same round."""
+    from shipgym.models import RVGParams
+    from shipgym.models.integrate import NOMOTO1
+    from shipgym.models.rvg import pack_rvg
+    from shipgym.sysid import fit as nf
+    from shipgym.sysid.families import rvg as fr
+    from shipgym.sysid.generator import generate_record
+
+    rec = generate_record(None, maneuver="random", dt=0.1, duration=duration, seed=seed)
+    h, _, n_cmd = nf._replay_inputs(rec.time, rec.delta, np.ones_like(rec.time))
+    speed = np.ones_like(rec.time)
+    p0 = nf.pack_nomoto(nf.Nomoto1Params(), nf._REPLAY_GEAR, nf._REPLAY_SURGE)
+    x0 = np.zeros(6)
+
+    def nomoto(ps: list[np.ndarray]) -> Any:
+        return nf._replay_kernel(
+            NOMOTO1, [x0] * len(ps), rec.delta, [0.0] * len(ps), speed, n_cmd, h, ps, rec.n
+        )
+
+    if gunnerus is not None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            rvg_rec = load(gunnerus, "gunnerus")
+        rvg_name = "rvg3dof, Gunnerus sea trials"
+    else:
+        rvg_rec = generate_record(None, dt=0.5, duration=duration, seed=seed, base_model="rvg3dof")
+        rvg_name = "rvg3dof, generated record"
+    starts = window_starts(rvg_rec.time, fr.RVG_WINDOW_S)
+    args = (rvg_rec.time, fr.start_states(rvg_rec), rvg_rec.rpm, fr.azimuth_orders(rvg_rec), starts)
+    q0 = pack_rvg(RVGParams())
+
+    def rvg(ps: list[np.ndarray]) -> Any:
+        k = len(ps)
+        return fr._replay(*args, ps, [(0.0, 0.0)] * k, [0.0] * k, [0.0] * k)
+
+    cases = [
+        ("nomoto1, generated random rudder", rec.n, nomoto, p0, 4),
+        (rvg_name, rvg_rec.n, rvg, q0, 8),
+    ]
+    out = []
+    for name, samples, replay, base, columns in cases:
+        # the variants a Jacobian replays: each parameter in turn nudged by a relative 1e-8
+        variants = []
+        for i in range(columns):
+            q = base.copy()
+            q[-1 - i] *= 1.0 + 1e-8
+            variants.append(q)
+        replay(variants[:1])  # compile
+        replay(variants)
+        one, side = [], []
+        for r in range(rounds):
+            t0 = time.perf_counter()
+            for q in variants:
+                replay([q])
+            t1 = time.perf_counter()
+            replay(variants)
+            t2 = time.perf_counter()
+            one.append(t1 - t0)
+            side.append(t2 - t1)
+            say(f"replays {name}: round {r + 1}/{rounds}: {(t1 - t0) / (t2 - t1):.2f} x")
+        speedup = statistics.median(a / b for a, b in zip(one, side, strict=True))
+        out.append({
+            "name": name, "samples": samples, "columns": columns, "one_at_a_time_s": one,
+            "side_by_side_s": side, "speedup": speedup,
+        })  # fmt: skip
+    return out
 
 
 def _system(elapsed: float) -> dict[str, Any]:
@@ -1199,7 +1281,37 @@ def format_benchmark(report: Mapping[str, Any]) -> str:
             f"| {r['description']} | {r['samples']} | {r['median_s']:.3f} | {len(r['times_s'])} "
             f"| {r['goal_s']:g} | {r['ratio']:.3f} | {'met' if r['met'] else 'missed'} |"
         )
+    if report.get("replays"):
+        lines += [
+            "",
+            "| a Jacobian's replays | samples | columns | one at a time [s] | side by side [s] "
+            "| speed-up |",
+            "|---|---:|---:|---:|---:|---:|",
+        ]
+        for r in report["replays"]:
+            lines.append(
+                f"| {r['name']} | {r['samples']} | {r['columns']} | "
+                f"{statistics.median(r['one_at_a_time_s']):.3f} | "
+                f"{statistics.median(r['side_by_side_s']):.3f} | {r['speedup']:.2f} x |"
+            )
     return "\n".join(lines)
+
+
+def _plot_replays(ax: Any, replays: list[dict[str, Any]]) -> None:
+    """Speed-up of a Jacobian's replays side by side over one at a time, one bar per model."""
+    y = np.arange(len(replays))[::-1]
+    for yi, r in zip(y, replays, strict=True):
+        ax.barh(yi, r["speedup"], height=0.55, color="#3b6ea8", zorder=2)
+        ax.annotate(
+            f"{r['speedup']:.2f} x ({r['columns']} replays of {r['samples']} samples)",
+            xy=(r["speedup"], yi), xytext=(4, 0), textcoords="offset points", va="center",
+            fontsize=9,
+        )  # fmt: skip
+    ax.axvline(1.0, color="black", ls="--", lw=1.2)
+    ax.set_yticks(y, [r["name"] for r in replays], fontsize=8)
+    ax.set_xlim(0.0, max(r["speedup"] for r in replays) * 1.6)
+    ax.set_xlabel("speed-up of a Jacobian's replays side by side (median of same-round ratios)")
+    ax.grid(True, axis="x", alpha=0.25)
 
 
 def plot_benchmark(report: Mapping[str, Any], path: str | Path) -> Path:
@@ -1210,9 +1322,20 @@ def plot_benchmark(report: Mapping[str, Any], path: str | Path) -> Path:
     from matplotlib.ticker import FuncFormatter
 
     rows = list(report["results"])
-    fig = Figure(figsize=(10, 1.6 + 0.9 * len(rows)), dpi=110, layout="constrained")
+    replays = list(report.get("replays") or [])
+    fig = Figure(
+        figsize=(10, 1.6 + 0.9 * len(rows) + (1.4 + 0.6 * len(replays) if replays else 0.0)),
+        dpi=110,
+        layout="constrained",
+    )
     FigureCanvasAgg(fig)
-    ax = fig.subplots()
+    if replays:
+        ax, ax_r = fig.subplots(
+            2, 1, height_ratios=[0.9 * len(rows) + 1.0, 0.6 * len(replays) + 0.8]
+        )
+        _plot_replays(ax_r, replays)
+    else:
+        ax = fig.subplots()
     y = np.arange(len(rows))[::-1]
     for yi, r in zip(y, rows, strict=True):
         goal = r["goal_s"]

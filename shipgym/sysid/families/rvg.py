@@ -99,7 +99,7 @@ from scipy.signal import savgol_filter
 
 from shipgym.models import RVGParams
 from shipgym.models._jit import kernel, row_kernel
-from shipgym.models.integrate import RVG3DOF, SIMD_LANES, rk4_block
+from shipgym.models.integrate import RVG3DOF, rk4_block
 from shipgym.models.model_file import rvg_document
 from shipgym.models.rvg import (
     DRAUGHT,
@@ -117,7 +117,7 @@ from shipgym.models.rvg import (
     pack_rvg,
     pod_thrusts_col,
 )
-from shipgym.sysid.batched import SideBySide
+from shipgym.sysid.batched import SideBySide, lanes
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
     Candidate,
@@ -435,25 +435,20 @@ def _replay(
 ) -> np.ndarray:
     """States ``(n, variants, 10)`` of :func:`_windows_kernel` for the variants given by their
     packed parameters (``pack_rvg``), currents ``(V_n, V_e)``, azimuth offsets and transverse
-    speed offsets, one entry each per variant.
-
-    Several variants are padded with copies of the last to a multiple of
-    :data:`~shipgym.models.integrate.SIMD_LANES`: the loops over them then run in whole SIMD
-    vectors, where a remainder would run one variant at a time.
+    speed offsets, one entry each per variant (padded to whole SIMD vectors,
+    :func:`shipgym.sysid.batched.lanes`).
     """
-    n_var = len(packed)
-    width = n_var if n_var == 1 else -(-n_var // SIMD_LANES) * SIMD_LANES
-    pick = np.minimum(np.arange(width), n_var - 1)
+    pick = lanes(len(packed))
     P = np.ascontiguousarray(np.column_stack(packed)[:, pick])
     P.flags.writeable = False
-    out = np.empty((time.size, width, 10))
+    out = np.empty((time.size, pick.size, 10))
     _windows_kernel(
         time, meas, rpm, az, np.asarray(starts, dtype=np.int64), P,
         np.ascontiguousarray(np.asarray(current, dtype=np.float64)[pick].T),
         np.asarray(alpha_0, dtype=np.float64)[pick], np.asarray(v_0, dtype=np.float64)[pick],
         out,
     )  # fmt: skip
-    return out[:, :n_var]
+    return out[:, : len(packed)]
 
 
 def measured_states(record: Record) -> np.ndarray:
