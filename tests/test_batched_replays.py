@@ -148,7 +148,7 @@ def test_rvg_variants_replayed_side_by_side_equal_each_replayed_alone() -> None:
 def test_nomoto_variants_replayed_side_by_side_equal_each_replayed_alone() -> None:
     rec = generate_record(None, maneuver="random", dt=0.2, duration=300.0, seed=1)
     speed = np.full(rec.n, 7.0)
-    h, _, n_cmd = nf._replay_inputs(rec.time, rec.delta, speed)
+    h, n_cmd = nf._replay_steps(rec.time, speed)
     _, ps = _variants("nomoto2", 5)
     x0s = [np.array([0.0, 0.0, 0.1 * b, 7.0, 0.0, 0.001 * b, 0.0]) for b in range(5)]
     d0s = [0.0, 0.01, -0.02, 0.005, 0.0]

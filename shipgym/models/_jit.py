@@ -189,7 +189,7 @@ def _param(p, k, b):  # type: ignore[no-untyped-def]  # Numba matches the names
     return lambda p, k, b: p[k, b]
 
 
-@overload(param_nonzero, jit_options={"nogil": True, "error_model": "numpy"})
+@overload(param_nonzero, jit_options={"nogil": True, "error_model": "numpy", "forceinline": True})
 def _param_nonzero(p, k, n):  # type: ignore[no-untyped-def]
     """Numba's implementation of :func:`param_nonzero` for the type of ``p``."""
     if p.ndim == 1:

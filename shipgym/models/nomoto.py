@@ -265,7 +265,9 @@ def _actuators_and_kinematics(X, U, p, C, b):
 
     The model functions here take a block of ships column by column (``X`` states x ships,
     ``U`` inputs x ships, ``C`` north/east current x ships, ``K`` the derivative), as
-    :func:`shipgym.models.integrate.rk4_block` steps them; one ship is a block of one.
+    :func:`shipgym.models.integrate.rk4_block` steps them; one ship is a block of one. ``p`` is
+    the packed parameter vector shared by the block, or a table of them with a column per ship
+    (:func:`shipgym.models._jit.param`).
     Straight-line code (the sine and cosine of :mod:`shipgym.models.vmath`) that reads every
     input before it writes, so a loop over the ships compiles to SIMD code.
     """

@@ -517,15 +517,16 @@ def pod_thrusts(rpm, x, c, p):
 def rvg_col(X, U, p, C, K, b):
     """RVG 3-DOF derivative (seed 001 eq. 5-20) of ship ``b`` of a block, written into ``K``.
 
-    ``X`` (states x ships), ``U`` (inputs x ships), ``C`` (north/east current x ships) and
-    ``K`` hold a block of ships column by column (:func:`shipgym.models.integrate.rk4_block`);
-    one ship is a block of one. The function is straight-line arithmetic, its sines, cosines
-    and arctangents those of :mod:`shipgym.models.vmath`, so a loop over the ships of a block
-    compiles to SIMD code. The terms that are zero in seed 001 (pod lift, turning speed loss,
-    wave resistance) are computed whatever their coefficient; the cross-flow integral, the one
-    term with a loop of its own, is added by :func:`rvg_crossflow_col` after this function
-    when its coefficient is not zero (``block_rhs`` calls both), so that this loop stays
-    straight-line code.
+    ``X`` (states x ships), ``U`` (inputs x ships), ``C`` (north/east current x ships) and ``K``
+    hold a block of ships column by column (:func:`shipgym.models.integrate.rk4_block`); one
+    ship is a block of one. ``p`` is :func:`pack_rvg`'s vector, shared by the block, or a table
+    of such vectors with a column per ship (:func:`shipgym.models._jit.param`). The function is
+    straight-line arithmetic, its sines, cosines and arctangents those of
+    :mod:`shipgym.models.vmath`, so a loop over the ships of a block compiles to SIMD code. The
+    terms that are zero in seed 001 (pod lift, turning speed loss, wave resistance) are computed
+    whatever their coefficient; the cross-flow integral, the one term with a loop of its own, is
+    added by :func:`rvg_crossflow_col` after this function when its coefficient is not zero
+    (``block_rhs`` calls both), so that this loop stays straight-line code.
     """
     sn, cs = sincos(X[IPSI, b])
     uu = X[IU, b]

@@ -480,13 +480,11 @@ def _replay_kernel(
     return out[:, : len(p)]
 
 
-def _replay_inputs(
-    t: np.ndarray, delta: np.ndarray, speed: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _replay_steps(t: np.ndarray, speed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The replay's steps ``h`` [s] and the surge model's command for the recorded speed (its
+    first-order lead, as the rudder's in :func:`_replay_loop`)."""
     h = np.diff(t)
-    dc = delta[:-1] + _REPLAY_TC * np.diff(delta) / h
-    n_cmd = speed[:-1] + _REPLAY_TC * np.diff(speed) / h
-    return h, dc, n_cmd
+    return h, speed[:-1] + _REPLAY_TC * np.diff(speed) / h
 
 
 def replay(
@@ -541,7 +539,7 @@ def _replay_arrays(
     delta: np.ndarray,
     speed: np.ndarray,
 ) -> np.ndarray:
-    h, _, n_cmd = _replay_inputs(t, delta, speed)
+    h, n_cmd = _replay_steps(t, speed)
     return _replay_kernel(model_id, [x0], delta, [0.0], speed, n_cmd, h, [p], t.shape[0])[:, 0]
 
 
@@ -1167,7 +1165,7 @@ def fit_output_error(
         d0 = float(theta[idx["delta0"]]) if "delta0" in idx else 0.0
         return vals, x, d0
 
-    h, _, n_cmd = _replay_inputs(t, delta, speed)
+    h, n_cmd = _replay_steps(t, speed)
     # actuator/surge head of the parameter vector (layout owned by ``pack_nomoto``); the yaw
     # coefficients follow, unvalidated, since the optimiser may probe any values
     head = pack_nomoto(cls(), _REPLAY_GEAR, _REPLAY_SURGE)[:P_YAW]

@@ -1182,7 +1182,7 @@ def _bench_replays(
     from shipgym.sysid.generator import generate_record
 
     rec = generate_record(None, maneuver="random", dt=0.1, duration=duration, seed=seed)
-    h, _, n_cmd = nf._replay_inputs(rec.time, rec.delta, np.ones_like(rec.time))
+    h, n_cmd = nf._replay_steps(rec.time, np.ones_like(rec.time))
     speed = np.ones_like(rec.time)
     p0 = nf.pack_nomoto(nf.Nomoto1Params(), nf._REPLAY_GEAR, nf._REPLAY_SURGE)
     x0 = np.zeros(6)
