@@ -174,12 +174,37 @@ def one_at_a_time(monkeypatch: pytest.MonkeyPatch):
     return use
 
 
-def test_rvg_fit_with_side_by_side_jacobians_is_the_one_at_a_time_fit(one_at_a_time) -> None:
+def test_side_by_side_batches_stay_within_the_memory_budget(monkeypatch) -> None:
+    calls: list[int] = []
+
+    def residuals(points: np.ndarray) -> list[np.ndarray]:
+        calls.append(len(points))
+        return [2.0 * p for p in points]
+
+    w, per = I.SIMD_LANES, 1000
+    monkeypatch.setattr(batched, "BATCH_BYTES", (2 * w + 3) * per)  # room for 2 vectors and 3
+    pts = [np.full(3, float(i)) for i in range(4 * w + 3)]
+    out = batched.SideBySide(residuals, per)(None, iter(pts))
+    assert calls == [2 * w, 2 * w, 3]
+    assert [o[0] for o in out] == [2.0 * i for i in range(4 * w + 3)]
+    calls.clear()
+    monkeypatch.setattr(batched, "BATCH_BYTES", (w - 1) * per)  # not one vector: one at a time
+    batched.SideBySide(residuals, per)(None, pts[:3])
+    assert calls == [1, 1, 1]
+
+
+@pytest.mark.parametrize("batches", ["one", "several"])
+def test_rvg_fit_with_side_by_side_jacobians_is_the_one_at_a_time_fit(
+    one_at_a_time, monkeypatch, batches: str
+) -> None:
     rec = _rvg_record()
     starts = window_starts(rec.time, 60.0)
     mask = np.ones(rec.n, dtype=bool)
     mask[starts] = False
     effects = ("thruster_lift", "current")
+    if batches == "several":  # one SIMD vector of replays per batch: the 9 go as 8 and 1
+        per_point = (10 * mask[::2].size + 6 * int(mask[::2].sum())) * 8
+        monkeypatch.setattr(batched, "BATCH_BYTES", I.SIMD_LANES * per_point)
     fast = fr.fit_rvg(rec, starts, mask, effects, max_nfev=12, stride=2)
     one_at_a_time()
     slow = fr.fit_rvg(rec, starts, mask, effects, max_nfev=12, stride=2)

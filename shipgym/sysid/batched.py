@@ -20,12 +20,17 @@ import numpy as np
 
 from shipgym.models.integrate import SIMD_LANES
 
-__all__ = ["SideBySide", "lanes"]
+__all__ = ["BATCH_BYTES", "SideBySide", "lanes"]
+
+#: Memory [bytes] one batch of side-by-side replays may take (their states and residuals); a
+#: Jacobian whose replays need more runs in several batches, one SIMD vector of replays at
+#: least, or one replay at a time where even that does not fit (a very long record).
+BATCH_BYTES = 256 * 2**20
 
 
 class SideBySide:
-    """Map-like ``workers`` for :func:`scipy.optimize.least_squares` that evaluates every
-    point of a finite-difference Jacobian in one call of a batched residual function.
+    """Map-like ``workers`` for :func:`scipy.optimize.least_squares` that evaluates the points
+    of a finite-difference Jacobian together, in calls of a batched residual function.
 
     Parameters
     ----------
@@ -34,13 +39,24 @@ class SideBySide:
         vectors of the fit's residual function at those points, computed together. It must be
         the batched form of the residual function given to ``least_squares``: the ``fun``
         that ``least_squares`` passes in is not called.
+    bytes_per_point : int
+        Memory one point's replay and residuals take: the points go in batches of whole SIMD
+        vectors within :data:`BATCH_BYTES`.
     """
 
-    def __init__(self, residuals: Callable[[np.ndarray], Sequence[np.ndarray]]) -> None:
+    def __init__(
+        self, residuals: Callable[[np.ndarray], Sequence[np.ndarray]], bytes_per_point: int
+    ) -> None:
         self._residuals = residuals
+        fit = BATCH_BYTES // max(int(bytes_per_point), 1)
+        self.batch = fit // SIMD_LANES * SIMD_LANES if fit >= SIMD_LANES else 1
 
     def __call__(self, fun: Any, points: Iterable[np.ndarray]) -> list[np.ndarray]:
-        return list(self._residuals(np.array(list(points), dtype=np.float64)))
+        pts = np.array(list(points), dtype=np.float64)
+        out: list[np.ndarray] = []
+        for i in range(0, len(pts), self.batch):
+            out += list(self._residuals(pts[i : i + self.batch]))
+        return out
 
 
 def lanes(variants: int) -> np.ndarray:

@@ -1207,7 +1207,7 @@ def fit_output_error(
         return residuals_of(theta[None, :])[0]
 
     bounds = (lower, np.full(len(names), np.inf))
-    side_by_side = SideBySide(residuals_of)
+    side_by_side = SideBySide(residuals_of, (nx + 2) * n * 8)  # states and residuals
     sol = least_squares(
         residuals, theta0, bounds=bounds, x_scale="jac", method="trf", max_nfev=max_nfev,
         workers=side_by_side,

@@ -770,7 +770,10 @@ def fit_rvg(
                 max_nfev=max_nfev,
                 ftol=FIT_TOL[0],
                 xtol=FIT_TOL[1],
-                workers=SideBySide(lambda ths, s=sig: _residuals_of(variants(ths), meas, mask, s)),
+                workers=SideBySide(
+                    lambda ths, s=sig: _residuals_of(variants(ths), meas, mask, s),
+                    (10 * time_.size + 6 * int(mask.sum())) * 8,  # states and residuals
+                ),
             )
         theta0 = sol.x
         sim = simulate(sol.x)
