@@ -11,7 +11,8 @@ Times (median after a warm-up for Numba, see :func:`shipgym.sysid.report.benchma
 loop on a 10 001-sample generated record with one effect (goal 10 s) and ``identify`` with base
 ``rvg3dof`` on the Gunnerus sea trials (goal 60 s; skipped with a message while unavailable),
 and the 3-DOF ``vmm:martin_simple`` on the 13 HSVA KVLCC2 runs together (regression goal 5 s,
-whole loop goal 60 s).
+whole loop goal 60 s); then one finite-difference Jacobian's replays of ``nomoto1`` and
+``rvg3dof``, one at a time against side by side, in interleaved rounds (the speed-up, no goal).
 Prints each time with its goal and ratio, writes ``OUT/bench_sysid.json`` and
 ``OUT/bench_sysid.png`` and, when the README has them, refreshes the block between
 ``<!-- bench_sysid -->`` and ``<!-- /bench_sysid -->``. The exit code does not depend on the

@@ -989,7 +989,10 @@ def benchmark_sysid(
       :mod:`shipgym.sysid.families.rvg` is not registered);
     * ``hsva_regression``, ``hsva_loop`` (``kvlcc2``): the 3-DOF :data:`BENCH_VMM` on the 13
       HSVA KVLCC2 runs under ``root`` together: the inverse-dynamics regression (loading and
-      filtering included; median of ``repeats``) and the whole identification loop (one run).
+      filtering included; median of ``repeats``) and the whole identification loop (one run);
+    * ``replays`` (a list beside ``results``, no goal): one finite-difference Jacobian's replays
+      one at a time and side by side, in at least 5 interleaved rounds, and the median of the
+      same-round speed-ups (:func:`_bench_replays`).
 
     ``duration`` [s] sets the length of the generated records (1000 s: 10 001 samples; shorter
     only for smoke tests). Each is preceded by an untimed warm-up on a short record (Numba
@@ -999,8 +1002,9 @@ def benchmark_sysid(
     Returns
     -------
     dict
-        ``config``, ``system`` and ``results`` (list of ``{name, description, samples,
-        goal_s, times_s, median_s, ratio, met, skipped, details}``).
+        ``config``, ``system``, ``results`` (list of ``{name, description, samples,
+        goal_s, times_s, median_s, ratio, met, skipped, details}``) and ``replays`` (list of
+        ``{name, samples, columns, one_at_a_time_s, side_by_side_s, speedup}``).
     """
     from shipgym.sysid.fit import fit_output_error
     from shipgym.sysid.generator import generate_record
