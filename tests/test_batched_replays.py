@@ -37,6 +37,9 @@ def test_lanes_pad_several_variants_to_whole_simd_vectors() -> None:
     assert batched.lanes(3).tolist() == [0, 1, 2] + [2] * (w - 3)
     assert batched.lanes(w).tolist() == list(range(w))
     assert batched.lanes(w + 1).tolist() == [*range(w + 1)] + [w] * (w - 1)
+    for bad in (0, -3, 2.0, True):
+        with pytest.raises(ValueError, match="variants must be an integer >= 1"):
+            batched.lanes(bad)
 
 
 def _variants(name: str, ships: int) -> tuple[int, list[np.ndarray]]:

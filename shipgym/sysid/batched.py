@@ -63,6 +63,14 @@ def lanes(variants: int) -> np.ndarray:
     """Which variant each ship of a block replays: ``0 .. variants - 1``, and for several
     variants the last again up to a multiple of
     :data:`~shipgym.models.integrate.SIMD_LANES`, so that the loops over the ships run in whole
-    SIMD vectors (a remainder would run one ship at a time). One variant is a block of one."""
+    SIMD vectors (a remainder would run one ship at a time). One variant is a block of one.
+
+    Raises
+    ------
+    ValueError
+        Unless ``variants`` is an integer >= 1.
+    """
+    if isinstance(variants, bool) or not isinstance(variants, int | np.integer) or variants < 1:
+        raise ValueError(f"variants must be an integer >= 1 (replays of a block), got {variants!r}")
     width = variants if variants == 1 else -(-variants // SIMD_LANES) * SIMD_LANES
     return np.minimum(np.arange(width), variants - 1)
