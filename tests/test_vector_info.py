@@ -247,9 +247,78 @@ def test_autoresets_use_the_reset_options_only_with_keep_options(
     assert not np.any(info["current_speed"] == 0.3)
 
 
-def test_keep_options_must_be_a_bool() -> None:
-    with pytest.raises(ValueError, match="keep_options"):
-        gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point", keep_options=1)
+@pytest.mark.parametrize("flag", ["keep_options", "step_info"])
+def test_flags_must_be_bools(flag: str) -> None:
+    with pytest.raises(ValueError, match=f"{flag} must be True or False, got 1"):
+        gym.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point", **{flag: 1})
+
+
+@pytest.mark.parametrize("mode", MODES, ids=lambda m: m.value)
+@pytest.mark.parametrize("env_id", ["shipgym/NomotoHeading-v0", "shipgym/RVGPathFollowing-v1"])
+def test_without_step_info_only_what_autoresets_hand_over(env_id: str, mode: AutoresetMode) -> None:
+    """``step_info=False`` steps exactly as the full env (episode ends, blow-ups and task
+    failures included) and returns no ``info`` but the finished episodes' ``final_obs``."""
+    kwargs = FAILING.get(env_id, {})
+    full, _ = make_pair(env_id, mode, **kwargs)
+    lean = gym.make_vec(
+        env_id,
+        num_envs=NUM_ENVS,
+        vectorization_mode="vector_entry_point",
+        autoreset_mode=mode,
+        max_episode_steps=LIMIT,
+        step_info=False,
+        **kwargs,
+    )
+    assert lean.reset(seed=3)[1] == {}
+    full.reset(seed=3)
+    full.action_space.seed(3)
+    blow_ups = dict(BLOW_UPS)
+    finished = 0
+    for t in range(N_STEPS):
+        if t in blow_ups:
+            for venv in (full, lean):
+                venv.unwrapped.task.x[blow_ups[t], 3] = np.nan
+        action = full.action_space.sample()
+        out_f, out_l = full.step(action), lean.step(action)
+        for k, name in enumerate(("obs", "reward", "terminated", "truncated")):
+            assert np.array_equal(out_l[k], out_f[k]), f"step {t}: {name}"
+        info_f, info_l = out_f[4], out_l[4]
+        done = out_f[2] | out_f[3]
+        finished += int(done.any())
+        if mode is AutoresetMode.SAME_STEP and done.any():
+            assert sorted(info_l) == ["_final_obs", "final_obs"], f"step {t}"
+            assert info_l["_final_obs"].tolist() == info_f["_final_obs"].tolist() == done.tolist()
+            for i in range(NUM_ENVS):
+                expected = info_f["final_obs"][i]
+                got = info_l["final_obs"][i]
+                assert (got is None) if expected is None else np.array_equal(got, expected)
+        else:
+            assert info_l == {}, f"step {t}: {sorted(info_l)}"
+    assert finished >= 3  # truncations, blow-ups and failures all went through the lean path
+    assert lean.reset()[1] == {}
+
+
+def test_sb3_adapter_builds_no_info_it_does_not_pass_on() -> None:
+    """SB3's per-env dicts carry only the terminal observation and the truncation flag: the
+    adapter's vector env builds nothing else, and those two are the full env's."""
+    from shipgym.rl.vec_env import ShipgymVecEnv
+
+    venv = ShipgymVecEnv(ENV_ID, NUM_ENVS, fixed_seed=0, max_episode_steps=LIMIT)
+    full, _ = make_pair(ENV_ID, AutoresetMode.SAME_STEP)
+    assert venv.venv.unwrapped.step_info is False
+    full.reset(seed=0)
+    venv.reset()
+    action = np.full((NUM_ENVS, 1), 0.3, dtype=np.float32)
+    for _ in range(LIMIT):
+        venv.step_async(action)
+        obs, _, dones, infos = venv.step_wait()
+        obs_f, _, _, trunc, info = full.step(action)
+        assert np.array_equal(obs, obs_f)
+    assert dones.all() and trunc.all()  # every sub-env truncated at the limit
+    for i in range(NUM_ENVS):
+        assert sorted(infos[i]) == ["TimeLimit.truncated", "terminal_observation"]
+        assert infos[i]["TimeLimit.truncated"] is True
+        assert np.array_equal(infos[i]["terminal_observation"], info["final_obs"][i])
 
 
 def test_sb3_adapter_keeps_its_reset_options_for_autoresets() -> None:
