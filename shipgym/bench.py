@@ -10,6 +10,9 @@ All numbers come from one process, so they share the machine state and are compa
   ``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")``, against
   Gymnasium's ``CartPoleVectorEnv(num_envs=N)``, each stepped with one fixed batch of random
   actions (autoreset inside the env). Ratio ``env_sps / cartpole_sps`` (higher is better).
+  The envs with a vector target are also timed with ``step_info=False`` (no ``info`` built,
+  as a training loop that never reads it runs them; :class:`~shipgym.envs.core.ShipVectorEnv`),
+  which shows how much of the step the ``info`` takes; the targets are for the full ``info``.
 
 Every env is made and warmed up first; then each of the ``repeats`` rounds times one loop of
 every measurement in turn, CartPole included, and a measurement's ratio is the median over the
@@ -81,6 +84,8 @@ class Measurement:
         Every repeat (same unit), one per round.
     threads : int
         Threads of a vector env's step (``num_threads``); 1 for the single env and CartPole.
+    info : bool
+        Whether a vector env's step built its ``info`` (``step_info``); True for the others.
     ratio : float or None
         Against CartPole: the median of ``round_ratios`` (``None`` for the CartPole lines).
     round_ratios : list of float
@@ -96,6 +101,7 @@ class Measurement:
     median: float
     repeats: list[float] = field(default_factory=list)
     threads: int = 1
+    info: bool = True
     ratio: float | None = None
     round_ratios: list[float] = field(default_factory=list)
     target: str | None = None
@@ -107,8 +113,10 @@ class Measurement:
 
 
 def _check_target(
-    kind: str, env_id: str, threads: int, ratio: float
+    kind: str, env_id: str, threads: int, ratio: float, info: bool = True
 ) -> tuple[str | None, bool | None]:
+    if not info:  # the targets are for the step with its info
+        return None, None
     all_threads = threads == available_threads() and threads > 1
     target = TARGETS.get((kind, env_id, 0 if all_threads else threads))
     if target is None:
@@ -122,8 +130,8 @@ class _Loop:
     """One measurement's env, made and warmed up once, then timed one repeat at a time.
 
     ``kind`` ``"single"``: ``gymnasium.make(env_id)``, :meth:`time` returns seconds per step;
-    ``"vector"``: a vector env of ``num_envs`` (``threads``: its ``num_threads``), :meth:`time`
-    returns environment steps per second.
+    ``"vector"``: a vector env of ``num_envs`` (``threads``: its ``num_threads``, ``info``: its
+    ``step_info``), :meth:`time` returns environment steps per second.
     """
 
     def __init__(
@@ -134,11 +142,12 @@ class _Loop:
         warmup: int,
         num_envs: int = 1,
         threads: int = 1,
+        info: bool = True,
         seed: int = 0,
     ) -> None:
         self.kind, self.steps, self.num_envs = kind, steps, num_envs
         self.env: Any = (
-            gym.make(env_id) if kind == "single" else _make_vector(env_id, num_envs, threads)
+            gym.make(env_id) if kind == "single" else _make_vector(env_id, num_envs, threads, info)
         )
         self.env.action_space.seed(seed)
         self.action = self.env.action_space.sample()
@@ -170,13 +179,19 @@ class _Loop:
         self.env.close()
 
 
-def _make_vector(env_id: str, num_envs: int, threads: int = 1) -> gym.vector.VectorEnv:
+def _make_vector(
+    env_id: str, num_envs: int, threads: int = 1, info: bool = True
+) -> gym.vector.VectorEnv:
     if env_id == CARTPOLE_VECTOR:
         from gymnasium.envs.classic_control.cartpole import CartPoleVectorEnv
 
         return CartPoleVectorEnv(num_envs=num_envs)
     return gym.make_vec(
-        env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", num_threads=threads
+        env_id,
+        num_envs=num_envs,
+        vectorization_mode="vector_entry_point",
+        num_threads=threads,
+        step_info=info,
     )
 
 
@@ -294,10 +309,15 @@ def run_bench(
     warmup = max(10, steps // 10)
     vec_warmup = max(2, vec_steps // 10)
 
-    plan: list[tuple[str, str, int]] = [("single", e, 1) for e in (CARTPOLE_ID, *env_ids)]
+    plan: list[tuple[str, str, int, bool]] = [
+        ("single", e, 1, True) for e in (CARTPOLE_ID, *env_ids)
+    ]
+    with_target = {env_id for kind, env_id, _ in TARGETS if kind == "vector"}
     for env_id in (CARTPOLE_VECTOR, *env_ids):
         for count in [1] if env_id == CARTPOLE_VECTOR else thread_counts:
-            plan.append(("vector", env_id, count))
+            plan.append(("vector", env_id, count, True))
+        if env_id in with_target:  # and without building the info
+            plan.extend(("vector", env_id, count, False) for count in thread_counts)
 
     def say(line: str) -> None:
         if stream is not None:
@@ -308,12 +328,12 @@ def run_bench(
     loops: list[_Loop] = []
     with busy_cores:
         try:
-            for kind, env_id, count in plan:  # make and warm up every env first
+            for kind, env_id, count, info in plan:  # make and warm up every env first
                 single = kind == "single"
                 loops.append(
                     _Loop(kind, env_id, steps, warmup)
                     if single
-                    else _Loop(kind, env_id, vec_steps, vec_warmup, num_envs, count)
+                    else _Loop(kind, env_id, vec_steps, vec_warmup, num_envs, count, info)
                 )
             say(f"shipgym bench: {len(plan)} envs made and warmed up; {repeats} rounds")
             for r in range(repeats):  # every measurement once per round
@@ -325,27 +345,27 @@ def run_bench(
                 loop.close()
 
     results: list[Measurement] = []
-    reference = {kind: values[k] for k, (kind, env_id, _) in enumerate(plan)
+    reference = {kind: values[k] for k, (kind, env_id, _, _) in enumerate(plan)
                  if env_id in (CARTPOLE_ID, CARTPOLE_VECTOR)}  # fmt: skip
-    for k, (kind, env_id, count) in enumerate(plan, start=1):
+    for k, (kind, env_id, count, info) in enumerate(plan, start=1):
         v = values[k - 1]
         best = min(v) if kind == "single" else max(v)
-        m = Measurement(kind, env_id, best, statistics.median(v), v, count)
+        m = Measurement(kind, env_id, best, statistics.median(v), v, count, info)
         if env_id not in (CARTPOLE_ID, CARTPOLE_VECTOR):
             m.round_ratios = [a / b for a, b in zip(v, reference[kind], strict=True)]
             m.ratio = statistics.median(m.round_ratios)
             if not busy:  # the targets are for an idle machine
-                m.target, m.passed = _check_target(kind, env_id, count, m.ratio)
+                m.target, m.passed = _check_target(kind, env_id, count, m.ratio, info)
         results.append(m)
         extra = "" if m.ratio is None else f"  ratio {m.ratio:.3f}"
-        where = f"{env_id} ({count} thr)" if kind == "vector" else env_id
+        where = f"{env_id} ({_threads_label(m.threads, m.info)})" if kind == "vector" else env_id
         say(f"[{k:2d}/{len(plan)}] {kind:6s} {where:38s} {_fmt_value(m)}{extra}")
 
     ratios: dict[str, dict[str, float]] = {"single": {}, "vector": {}}
     for m in results:
         if m.ratio is not None:
             key = m.env_id if m.kind == "single" else f"{m.env_id} threads={m.threads}"
-            ratios[m.kind][key] = m.ratio
+            ratios[m.kind][key + ("" if m.info else " no info")] = m.ratio
     return {
         "config": {
             "steps": steps,
@@ -382,6 +402,11 @@ def run_bench(
     }
 
 
+def _threads_label(threads: int, info: bool) -> str:
+    """``"2 thr"``, or ``"2 thr, no info"`` for a vector step without its ``info``."""
+    return f"{threads} thr" + ("" if info else ", no info")
+
+
 def _numba_version() -> str:
     try:
         import numba
@@ -412,8 +437,9 @@ def format_table(report: dict[str, Any]) -> str:
         ratio = "-" if r["ratio"] is None else f"{r['ratio']:.3f}"
         target = r["target"] or "-"
         result = "" if r["passed"] is None else ("PASS" if r["passed"] else "MISS")
+        threads = f"{r.get('threads', 1)}" + ("" if r.get("info", True) else ", no info")
         lines.append(
-            f"| {what} | {r['env_id']} | {r.get('threads', 1)} | {best} | {median} | {ratio} "
+            f"| {what} | {r['env_id']} | {threads} | {best} | {median} | {ratio} "
             f"| {target} | {result} |"
         )
     return "\n".join(lines)
@@ -424,11 +450,12 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     cfg = report["config"]
-    fig = Figure(figsize=(12, 5.2), dpi=110, layout="constrained")
+    fig = Figure(figsize=(14, 5.8), dpi=110, layout="constrained")
     FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2)
+    axes = fig.subplots(1, 2, width_ratios=[1, 2.6])
     titles = {
         "single": (
             "single env: step time / CartPole-v1 step time\n(lower is better)",
@@ -444,7 +471,11 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         rows = [r for r in report["results"] if r["kind"] == kind and r["ratio"] is not None]
         names = [
             r["env_id"].removeprefix("shipgym/")
-            + (f" ({r.get('threads', 1)} thr)" if kind == "vector" else "")
+            + (
+                f" ({_threads_label(r.get('threads', 1), r.get('info', True))})"
+                if kind == "vector"
+                else ""
+            )
             for r in rows
         ]
         values = [r["ratio"] for r in rows]
@@ -453,7 +484,8 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
             for r in rows
         ]
         x = np.arange(len(rows))
-        bars = ax.bar(x, values, color=colors, width=0.6, zorder=2)
+        hatches = ["" if r.get("info", True) else "//" for r in rows]
+        bars = ax.bar(x, values, color=colors, width=0.6, zorder=2, hatch=hatches, ec="white")
         top = max([*values, *(float(r["target"].split()[1]) for r in rows if r["target"]), 1.0])
         ax.set_ylim(0, 1.18 * top)
         for bar, v in zip(bars, values, strict=True):
@@ -466,7 +498,7 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
                 textcoords="offset points",
                 ha="center",
                 va="top" if inside else "bottom",
-                fontsize=9,
+                fontsize=8,
                 fontweight="bold",
                 color="white" if inside else "black",
                 zorder=4,
@@ -488,7 +520,7 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85},
                 )
         ax.axhline(1.0, color="#555555", lw=0.8, zorder=1)
-        ax.set_xticks(x, names, rotation=20, ha="right")
+        ax.set_xticks(x, names, rotation=20 if kind == "single" else 35, ha="right", fontsize=9)
         ax.set_title(titles[kind][0], fontsize=10)
         ax.set_ylabel(titles[kind][1])
         ax.grid(True, axis="y", alpha=0.3, zorder=0)
@@ -496,10 +528,11 @@ def plot_ratios(report: dict[str, Any], path: str | Path) -> Path:
         Line2D([], [], color="#2a8a4a", lw=8, label="meets target"),
         Line2D([], [], color="#b8312f", lw=8, label="misses target"),
         Line2D([], [], color="#9a9a9a", lw=8, label="no target"),
+        Patch(fc="#9a9a9a", ec="white", hatch="//", label="without info (step_info=False)"),
         Line2D([], [], color="black", ls="--", lw=1.6, label="target"),
         Line2D([], [], color="#555555", lw=0.8, label="parity with CartPole"),
     ]
-    fig.legend(handles=handles, loc="outside lower center", ncols=5, fontsize=9)
+    fig.legend(handles=handles, loc="outside lower center", ncols=6, fontsize=9)
     sysinfo = report["system"]
     fig.suptitle(
         f"shipgym {sysinfo['shipgym']} speed vs Gymnasium CartPole (one process, "

@@ -71,9 +71,12 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
     report = json.loads(out.read_text())
     counts = sorted({1, available_threads()})  # one thread and one per CPU
     assert set(report["ratios"]["single"]) == set(CURRENT_ENV_IDS)
+    # the envs with a vector target also without building their info, and never checked then
+    lean = {"shipgym/NomotoHeading-v0", "shipgym/RVGPathFollowing-v1"}
     assert set(report["ratios"]["vector"]) == {
         f"{e} threads={t}" for e in CURRENT_ENV_IDS for t in counts
-    }
+    } | {f"{e} threads={t} no info" for e in lean for t in counts}
+    assert all(r["target"] is None for r in report["results"] if not r["info"])
     for kind in ("single", "vector"):
         assert all(math.isfinite(v) and v > 0 for v in report["ratios"][kind].values())
     assert report["config"]["num_envs"] == 4
@@ -82,6 +85,7 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
     # a table row per measurement with PASS/MISS where there is a target
     assert captured.out.count("| single env step time |") == len(CURRENT_ENV_IDS) + 1
     assert re.search(r"NomotoHeading-v0 .*\| (PASS|MISS) \|", captured.out)
+    assert re.search(r"NomotoHeading-v0 \| \d, no info \|", captured.out)
     # each ratio is the median of the ratios to CartPole timed in the same round
     results = report["results"]
     reference = {r["kind"]: r["repeats"] for r in results if r["ratio"] is None}
@@ -93,7 +97,8 @@ def test_bench_runs_and_writes_ratios(tmp_path: Path, capsys) -> None:
             assert r["ratio"] == pytest.approx(statistics.median(same_round), rel=1e-12)
     # progress: a line per round, then one per measurement
     assert len(re.findall(r"^  round \d/3 done", captured.err, flags=re.M)) == 3
-    n = 2 * (len(CURRENT_ENV_IDS) + 1) + len(CURRENT_ENV_IDS) * (len(counts) - 1)
+    n = 2 * (len(CURRENT_ENV_IDS) + 1) + (len(CURRENT_ENV_IDS) + len(lean)) * len(counts)
+    n -= len(CURRENT_ENV_IDS)
     assert len(re.findall(rf"^\[\s*\d+/{n}\]", captured.err, flags=re.M)) == n
 
 
