@@ -42,10 +42,13 @@ from shipgym.models.angles import ssa_scalar
 from shipgym.models.integrate import (
     BLOCK,
     RVG3DOF,
+    STATE_COUNTS,
     block_work,
     full_block_by_model,
     full_block_rvg,
-    rk4_rows,
+    gather_rows,
+    rk4_block_of,
+    scatter_rows,
 )
 from shipgym.models.rvg import P_TBOLL
 from shipgym.models.vmath import sincos
@@ -73,26 +76,46 @@ def _require_rvg(model_id):
         raise ValueError("the speed, path and target tasks sail the R/V Gunnerus (rvg3dof)")
 
 
-@row_kernel
-def _advance_block(full_block, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work):
-    """Clip the actions of rows ``rows[start .. start + n - 1]`` to [-1, 1], map them to inputs
-    (``u = u0 + B a``), count their step and take one RK4 step of the block
-    (:func:`~shipgym.models.integrate.rk4_rows`).
+# The loops over a row's states, inputs, actions and observations have their counts as
+# compile-time constants (the Gunnerus tasks' own, and each ship family's in the heading task):
+# a loop of a few iterations whose count is known at run time only is not unrolled, and keeps
+# the row logic from compiling to straight-line code (the heading kernel ran 1.8 x slower).
+#: States and inputs of the R/V Gunnerus.
+NX_RVG, NU_RVG = STATE_COUNTS[RVG3DOF], 4
+#: Actions and observations of the Gunnerus tasks' kernels (their tasks' ``act_dim``, ``obs_dim``).
+SPEED_DIMS, PATH_DIMS, TARGET_DIMS = (1, 4), (2, 9), (2, 10)
+#: (states, inputs, actions, observations) of the ship families the heading task sails: a
+#: first- and a second-order Nomoto-family ship and the Gunnerus (another count runs the same
+#: code with its counts known at run time only).
+HEADING_DIMS = ((6, 2, 1, 3), (7, 2, 1, 3), (NX_RVG, NU_RVG, 1, 5))
 
-    ``work`` is one block's work arrays (:func:`~shipgym.models.integrate.block_work`).
-    """
-    na = a.shape[1]
+
+@row_kernel
+def _map_and_gather(x, u, c, a, u0, B, steps, rows, start, n, work, nx, nu, na):
+    """Clip the actions of rows ``rows[start .. start + n - 1]`` (``na`` each) to [-1, 1], map
+    them to inputs (``u = u0 + B a``), count their step and copy the rows into the block work
+    arrays ``work`` (:func:`~shipgym.models.integrate.block_work`) for the RK4 step."""
     for j in range(start, start + n):
         i = rows[j]
         for k in range(na):
             a[i, k] = min(max(a[i, k], -1.0), 1.0)
-        for q in range(u0.shape[0]):
+        for q in range(nu):
             acc = u0[q]
             for k in range(na):
                 acc += B[q, k] * a[i, k]
             u[i, q] = acc
         steps[i] += 1
-    rk4_rows(full_block, model_id, x, u, p, c, dt, rows, start, n, work)
+    gather_rows(x, u, c, rows, start, n, work[0], work[1], work[2], nx, nu)
+
+
+@row_kernel
+def _advance_block(full_block, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work, na):
+    """:func:`_map_and_gather`, one RK4 step of the block
+    (:func:`~shipgym.models.integrate.rk4_block_of`) and the states copied back, for a
+    Gunnerus task with ``na`` actions."""
+    _map_and_gather(x, u, c, a, u0, B, steps, rows, start, n, work, NX_RVG, NU_RVG, na)
+    rk4_block_of(full_block, model_id, work[0], work[1], p, work[2], dt, n, work[3])
+    scatter_rows(work[0], rows, start, n, x, NX_RVG)
 
 
 # The row logic of the task kernels works a block of rows at a time: a helper that takes arrays
@@ -100,23 +123,21 @@ def _advance_block(full_block, model_id, x, u, p, c, dt, a, u0, B, steps, rows, 
 
 
 @row_kernel
-def _begin_block(x, obs, a, rows, start, n, ok, prev, cost, rew, term, reason):
-    """Start the row logic of rows ``rows[start .. start + n - 1]``: clear their flags, keep
-    their observations in ``prev`` (before they are recomputed) and the squared norm of their
-    actions in ``cost``; ``ok[b]`` False (and the row terminated with a blow-up) where the state
-    of the ``b``-th is not finite."""
+def _begin_block(x, a, rows, start, n, ok, cost, rew, term, reason, nx, na):
+    """Start the row logic of rows ``rows[start .. start + n - 1]`` (``nx`` states, ``na``
+    actions): clear their flags and keep the squared norm of their actions in ``cost``;
+    ``ok[b]`` False (and the row terminated with a blow-up) where the state of the ``b``-th is
+    not finite."""
     for b in range(n):
         i = rows[start + b]
         reason[i] = RUNNING
         term[i] = False
-        for k in range(obs.shape[1]):
-            prev[b, k] = obs[i, k]
         s = 0.0
-        for k in range(a.shape[1]):
+        for k in range(na):
             s += a[i, k] * a[i, k]
         cost[b] = s
         finite = True
-        for j in range(x.shape[1]):
+        for j in range(nx):
             finite &= math.isfinite(x[i, j])
         ok[b] = finite
         if not finite:
@@ -126,33 +147,32 @@ def _begin_block(x, obs, a, rows, start, n, ok, prev, cost, rew, term, reason):
 
 
 @row_kernel
-def _finish_block(obs, rows, start, n, ok, lo, hi, prev, rew, term, reason):
-    """Clip the observations of the block's rows (those with ``ok``) to the observation-space
-    bounds.
+def _finish_block(obs, rows, start, n, ok, lo, hi, new, rew, term, reason, nobs):
+    """Write the ``nobs`` new observations ``new`` of the block's rows (those with ``ok``) into
+    ``obs``, clipped to the observation-space bounds.
 
-    A NaN in the observation or the reward (a finite state whose observation overflowed) ends
-    the row as a blow-up: the observation ``prev`` it had before, reward 0.
+    A NaN in the new observation or the reward (a finite state whose observation overflowed)
+    ends the row as a blow-up: it keeps the observation it had before, reward 0.
     """
     for b in range(n):
         if not ok[b]:
             continue
         i = rows[start + b]
         bad = math.isnan(rew[i])
-        for k in range(obs.shape[1]):
-            bad |= math.isnan(obs[i, k])
+        for k in range(nobs):
+            bad |= math.isnan(new[b, k])
         if bad:
-            for k in range(obs.shape[1]):
-                obs[i, k] = prev[b, k]
             rew[i] = 0.0
             term[i] = True
             reason[i] = BLOW_UP
-        for k in range(obs.shape[1]):
-            obs[i, k] = min(max(obs[i, k], lo[k]), hi[k])
+        else:
+            for k in range(nobs):
+                obs[i, k] = min(max(new[b, k], lo[k]), hi[k])
 
 
 @row_kernel
 def _row_work(obs_dim):
-    """Scratch of the row logic of one block: ``ok``, ``prev`` and ``cost``."""
+    """Scratch of the row logic of one block: ``ok``, the new observations and ``cost``."""
     return np.empty(BLOCK, dtype=np.bool_), np.empty((BLOCK, obs_dim)), np.empty(BLOCK)
 
 
@@ -189,28 +209,91 @@ def _heading(
         bad = first_nonfinite_row(a)
         if bad >= 0:
             return bad
-    n_sp = schedule.shape[1]
+    dims = (x.shape[1], u.shape[1], a.shape[1], obs.shape[1])
+    family = -1  # the ship family of HEADING_DIMS whose counts are compile-time constants
+    for f in range(len(HEADING_DIMS)):
+        if dims == HEADING_DIMS[f]:
+            family = f
     n_rows = rows.shape[0]
     work = block_work(x.shape[1], u.shape[1], n_rows)
-    ok, prev, cost = _row_work(obs.shape[1])
+    ok, new, cost = _row_work(obs.shape[1])
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
-        if advance:
-            _advance_block(
-                full_block_by_model, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
-            )
-        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
-        for b in range(m):
-            if ok[b]:
-                i = rows[start + b]
-                psi_d = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
-                e = ssa_scalar(psi_d - x[i, ipsi])
-                obs[i, 0] = e
-                for k in range(obs_idx.shape[0]):
-                    obs[i, 1 + k] = x[i, obs_idx[k]]
-                rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
-        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+        if advance:  # one RK4 call site, between the copies of each family
+            if family == 0:
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, 6, 2, 1)
+            elif family == 1:
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, 7, 2, 1)
+            elif family == 2:
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, NX_RVG, NU_RVG, 1)
+            else:
+                _map_and_gather(
+                    x, u, c, a, u0, B, steps, rows, start, m, work, dims[0], dims[1], dims[2]
+                )
+            rk4_block_of(full_block_by_model, model_id, work[0], work[1], p, work[2], dt, m,
+                         work[3])  # fmt: skip
+        if family == 0:
+            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
+                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
+                          6, 1, 3)  # fmt: skip
+        elif family == 1:
+            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
+                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
+                          7, 1, 3)  # fmt: skip
+        elif family == 2:
+            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
+                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
+                          NX_RVG, 1, 5)  # fmt: skip
+        else:
+            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
+                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
+                          dims[0], dims[2], dims[3])  # fmt: skip
     return -1
+
+
+@row_kernel
+def _heading_rows(
+    advance,
+    x,
+    obs,
+    a,
+    rows,
+    start,
+    n,
+    XB,
+    ok,
+    new,
+    cost,
+    rew,
+    term,
+    reason,
+    ipsi,
+    obs_idx,
+    schedule,
+    hold_steps,
+    steps,
+    obs_lo,
+    obs_hi,
+    nx,
+    na,
+    nobs,
+):
+    """The heading task's rows ``rows[start .. start + n - 1]`` after their step (``nx``
+    states, ``na`` actions, ``nobs`` observations): the stepped states ``XB`` copied back (if
+    ``advance``), then the observations, rewards and flags (:func:`_heading`)."""
+    if advance:
+        scatter_rows(XB, rows, start, n, x, nx)
+    _begin_block(x, a, rows, start, n, ok, cost, rew, term, reason, nx, na)
+    last = schedule.shape[1] - 1
+    for b in range(n):
+        if ok[b]:
+            i = rows[start + b]
+            e = ssa_scalar(schedule[i, min(steps[i] // hold_steps, last)] - x[i, ipsi])
+            new[b, 0] = e
+            for k in range(nobs - 1):
+                new[b, 1 + k] = x[i, obs_idx[k]]
+            rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
+    _finish_block(obs, rows, start, n, ok, obs_lo, obs_hi, new, rew, term, reason, nobs)
 
 
 def _speed(
@@ -242,6 +325,7 @@ def _speed(
     clipped to their observation bounds (+-25 m/s, [0, 1]), so in ``[-12.55, 0]``.
     """
     _require_rvg(model_id)
+    na, nobs = SPEED_DIMS
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
@@ -250,14 +334,14 @@ def _speed(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     work = block_work(x.shape[1], u.shape[1], n_rows)
-    ok, prev, cost = _row_work(obs.shape[1])
+    ok, new, cost = _row_work(obs.shape[1])
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
             _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
             )
-        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
+        _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if ok[b]:
                 i = rows[start + b]
@@ -265,14 +349,14 @@ def _speed(
                 ur = x[i, 3] - (c[i, 0] * math.cos(psi) + c[i, 1] * math.sin(psi))
                 ud = schedule[i, min(steps[i] // hold_steps, n_sp - 1)]
                 frac = x[i, 6] / tb
-                obs[i, 0] = ud - ur
-                obs[i, 1] = ur
-                obs[i, 2] = frac
-                obs[i, 3] = ud
+                new[b, 0] = ud - ur
+                new[b, 1] = ur
+                new[b, 2] = frac
+                new[b, 3] = ud
                 e = min(max(ud - ur, obs_lo[0]), obs_hi[0])
                 f = min(max(frac, obs_lo[2]), obs_hi[2])
                 rew[i] = -abs(e) / 2.0 - 0.05 * f * f
-        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, nobs)
     return -1
 
 
@@ -328,6 +412,7 @@ def _path(
     ``-0.6 - 0.05 n_a``); +20 on reaching the last waypoint, -20 when ``|e| > max_cross_track``.
     """
     _require_rvg(model_id)
+    na, nobs = PATH_DIMS
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
@@ -335,7 +420,7 @@ def _path(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     work = block_work(x.shape[1], u.shape[1], n_rows)
-    ok, prev, cost = _row_work(obs.shape[1])
+    ok, new, cost = _row_work(obs.shape[1])
     s_before = np.empty(BLOCK)
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
@@ -353,9 +438,9 @@ def _path(
             )[1]
         if advance:
             _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
             )
-        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
+        _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if not ok[b]:
                 continue
@@ -397,15 +482,15 @@ def _path(
                 reason[i] = FAILURE
                 bonus = -20.0
             chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
-            obs[i, 0] = e
-            obs[i, 1] = chi_err
-            obs[i, 2] = s_left
-            obs[i, 3] = turn[i, k]
-            obs[i, 4] = x[i, 3]
-            obs[i, 5] = x[i, 4]
-            obs[i, 6] = x[i, 5]
-            obs[i, 7] = x[i, 8]
-            obs[i, 8] = x[i, 6] / tb
+            new[b, 0] = e
+            new[b, 1] = chi_err
+            new[b, 2] = s_left
+            new[b, 3] = turn[i, k]
+            new[b, 4] = x[i, 3]
+            new[b, 5] = x[i, 4]
+            new[b, 6] = x[i, 5]
+            new[b, 7] = x[i, 8]
+            new[b, 8] = x[i, 6] / tb
             rew[i] = (
                 0.5 * min(max(progress / (ref_speed * dt), -1.0), 1.0)
                 + 0.5 * math.exp(-((e / 25.0) ** 2))
@@ -413,7 +498,7 @@ def _path(
                 - 0.05 * cost[b]
                 + bonus
             )
-        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, nobs)
     return -1
 
 
@@ -449,6 +534,7 @@ def _target(
     at least ``-1 - 0.05 n_a``); -20 and termination when the distance exceeds ``max_distance``.
     """
     _require_rvg(model_id)
+    na, nobs = TARGET_DIMS
     if advance:
         bad = first_nonfinite_row(a)
         if bad >= 0:
@@ -456,18 +542,18 @@ def _target(
     tb = p[P_TBOLL]
     n_rows = rows.shape[0]
     work = block_work(x.shape[1], u.shape[1], n_rows)
-    ok, prev, cost = _row_work(obs.shape[1])
+    ok, new, cost = _row_work(obs.shape[1])
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
             _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work
+                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
             )
             for b in range(m):
                 i = rows[start + b]
                 target[i, 0] += target_vel[i, 0] * dt
                 target[i, 1] += target_vel[i, 1] * dt
-        _begin_block(x, obs, a, rows, start, m, ok, prev, cost, rew, term, reason)
+        _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if not ok[b]:
                 continue
@@ -481,22 +567,22 @@ def _target(
             rve = target_vel[i, 1] - ve
             d = math.hypot(dn, de)
             err = d - distance[i]
-            obs[i, 0] = cs * dn + sn * de
-            obs[i, 1] = -sn * dn + cs * de
-            obs[i, 2] = cs * rvn + sn * rve
-            obs[i, 3] = -sn * rvn + cs * rve
-            obs[i, 4] = err
-            obs[i, 5] = x[i, 3]
-            obs[i, 6] = x[i, 4]
-            obs[i, 7] = x[i, 5]
-            obs[i, 8] = x[i, 8]
-            obs[i, 9] = x[i, 6] / tb
+            new[b, 0] = cs * dn + sn * de
+            new[b, 1] = -sn * dn + cs * de
+            new[b, 2] = cs * rvn + sn * rve
+            new[b, 3] = -sn * rvn + cs * rve
+            new[b, 4] = err
+            new[b, 5] = x[i, 3]
+            new[b, 6] = x[i, 4]
+            new[b, 7] = x[i, 5]
+            new[b, 8] = x[i, 8]
+            new[b, 9] = x[i, 6] / tb
             rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * cost[b]
             if d > max_distance:
                 term[i] = True
                 reason[i] = FAILURE
                 rew[i] -= 20.0
-        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, prev, rew, term, reason)
+        _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, nobs)
     return -1
 
 

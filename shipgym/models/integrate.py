@@ -215,33 +215,33 @@ def block_work(nx, nu, n):
 
 
 @row_kernel
-def gather_rows(x, u, c, rows, start, n, XB, UB, CB):
-    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows) into a block."""
+def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
+    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows; ``nx`` states,
+    ``nu`` inputs) into a block."""
     for b in range(n):
         i = rows[start + b]
-        for j in range(x.shape[1]):
+        for j in range(nx):
             XB[j, b] = x[i, j]
-        for j in range(u.shape[1]):
+        for j in range(nu):
             UB[j, b] = u[i, j]
         CB[0, b] = c[i, 0]
         CB[1, b] = c[i, 1]
 
 
 @row_kernel
-def scatter_rows(XB, rows, start, n, x):
-    """Copy the block's states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
+def scatter_rows(XB, rows, start, n, x, nx):
+    """Copy the block's ``nx`` states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
     for b in range(n):
         i = rows[start + b]
-        for j in range(x.shape[1]):
+        for j in range(nx):
             x[i, j] = XB[j, b]
 
 
 @row_kernel
-def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
-    """One RK4 step of ships ``rows[start .. start + n - 1]`` of a batch (ships as rows): copied
-    into the block work arrays ``work`` (:func:`block_work`), stepped by :func:`rk4_block` (a
-    full block by ``full_block``: :func:`full_block_any`, :func:`full_block_by_model` or
-    :func:`full_block_rvg`; the same numbers, more or less code) and copied back.
+def rk4_block_of(full_block, model_id, X, U, p, C, h, n, W):
+    """:func:`rk4_block` of ships ``0 .. n-1`` of a block, a full block by ``full_block``
+    (:func:`full_block_any`, :func:`full_block_by_model` or :func:`full_block_rvg`; the same
+    numbers, more or less code).
 
     A full block is stepped with its width :data:`BLOCK` as a compile-time constant: the loops
     over its ships then have a known trip count, with no remainder loops and no run-time checks
@@ -250,19 +250,24 @@ def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
     block of one ship (the single env's step): a loop whose width is known at run time only
     costs about 60 ns to set up, more than one ship's derivative.
     """
-    XB, UB, CB, W = work
     if n == BLOCK:
-        gather_rows(x, u, c, rows, start, BLOCK, XB, UB, CB)
-        full_block(model_id, XB, UB, p, CB, h, W)
-        scatter_rows(XB, rows, start, BLOCK, x)
+        full_block(model_id, X, U, p, C, h, W)
     elif n == 1:
-        gather_rows(x, u, c, rows, start, 1, XB, UB, CB)
-        rk4_block(model_id, XB, UB, p, CB, h, 1, W)
-        scatter_rows(XB, rows, start, 1, x)
+        rk4_block(model_id, X, U, p, C, h, 1, W)
     else:
-        gather_rows(x, u, c, rows, start, n, XB, UB, CB)
-        rk4_block(model_id, XB, UB, p, CB, h, n, W)
-        scatter_rows(XB, rows, start, n, x)
+        rk4_block(model_id, X, U, p, C, h, n, W)
+
+
+@row_kernel
+def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
+    """One RK4 step of ships ``rows[start .. start + n - 1]`` of a batch (ships as rows): copied
+    into the block work arrays ``work`` (:func:`block_work`), stepped by :func:`rk4_block_of`
+    and copied back."""
+    XB, UB, CB, W = work
+    nx, nu = x.shape[1], u.shape[1]
+    gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu)
+    rk4_block_of(full_block, model_id, XB, UB, p, CB, h, n, W)
+    scatter_rows(XB, rows, start, n, x, nx)
 
 
 @row_kernel
@@ -286,9 +291,9 @@ def rhs_kernel(model_id, x, u, p, c, out):
         KB = W[0]
         for start in range(0, n, BLOCK):
             m = min(BLOCK, n - start)
-            gather_rows(x, u, c, rows, start, m, XB, UB, CB)
+            gather_rows(x, u, c, rows, start, m, XB, UB, CB, x.shape[1], u.shape[1])
             block_rhs(model_id, XB, UB, p, CB, KB, m)
-            scatter_rows(KB, rows, start, m, out)
+            scatter_rows(KB, rows, start, m, out, x.shape[1])
     else:
         for i in range(n):
             model_test_row(model_id, x[i], u[i], p, c[i], out[i])
