@@ -219,6 +219,7 @@ def _heading(
     for f in range(len(HEADING_DIMS)):
         if dims == HEADING_DIMS[f]:
             family = f
+    last = schedule.shape[1] - 1
     n_rows = rows.shape[0]
     work = block_work(x.shape[1], u.shape[1], n_rows)
     ok, new, cost = _row_work(obs.shape[1])
@@ -237,68 +238,37 @@ def _heading(
                 )
             rk4_block_of(full_block_by_model, model_id, work[0], work[1], p, work[2], dt, m,
                          work[3])  # fmt: skip
+            if family == 0:
+                scatter_rows(work[0], rows, start, m, x, 6)
+            elif family == 1:
+                scatter_rows(work[0], rows, start, m, x, 7)
+            elif family == 2:
+                scatter_rows(work[0], rows, start, m, x, NX_RVG)
+            else:
+                scatter_rows(work[0], rows, start, m, x, dims[0])
         if family == 0:
-            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
-                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
-                          6, 1, 3)  # fmt: skip
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, 6, 1)
         elif family == 1:
-            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
-                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
-                          7, 1, 3)  # fmt: skip
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, 7, 1)
         elif family == 2:
-            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
-                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
-                          NX_RVG, 1, 5)  # fmt: skip
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, 1)
         else:
-            _heading_rows(advance, x, obs, a, rows, start, m, work[0], ok, new, cost, rew, term,
-                          reason, ipsi, obs_idx, schedule, hold_steps, steps, obs_lo, obs_hi,
-                          dims[0], dims[2], dims[3])  # fmt: skip
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, dims[0], dims[2])
+        for b in range(m):
+            if ok[b]:
+                i = rows[start + b]
+                e = ssa_scalar(schedule[i, min(steps[i] // hold_steps, last)] - x[i, ipsi])
+                new[b, 0] = e
+                for k in range(obs_idx.shape[0]):
+                    new[b, 1 + k] = x[i, obs_idx[k]]
+                rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
+        if family == 0 or family == 1:
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, 3)
+        elif family == 2:
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, 5)
+        else:
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, dims[3])
     return -1
-
-
-@row_kernel
-def _heading_rows(
-    advance,
-    x,
-    obs,
-    a,
-    rows,
-    start,
-    n,
-    XB,
-    ok,
-    new,
-    cost,
-    rew,
-    term,
-    reason,
-    ipsi,
-    obs_idx,
-    schedule,
-    hold_steps,
-    steps,
-    obs_lo,
-    obs_hi,
-    nx,
-    na,
-    nobs,
-):
-    """The heading task's rows ``rows[start .. start + n - 1]`` after their step (``nx``
-    states, ``na`` actions, ``nobs`` observations): the stepped states ``XB`` copied back (if
-    ``advance``), then the observations, rewards and flags (:func:`_heading`)."""
-    if advance:
-        scatter_rows(XB, rows, start, n, x, nx)
-    _begin_block(x, a, rows, start, n, ok, cost, rew, term, reason, nx, na)
-    last = schedule.shape[1] - 1
-    for b in range(n):
-        if ok[b]:
-            i = rows[start + b]
-            e = ssa_scalar(schedule[i, min(steps[i] // hold_steps, last)] - x[i, ipsi])
-            new[b, 0] = e
-            for k in range(nobs - 1):
-                new[b, 1 + k] = x[i, obs_idx[k]]
-            rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
-    _finish_block(obs, rows, start, n, ok, obs_lo, obs_hi, new, rew, term, reason, nobs)
 
 
 def _speed(

@@ -215,9 +215,7 @@ def block_work(nx, nu, n):
 
 
 @row_kernel
-def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
-    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows; ``nx`` states,
-    ``nu`` inputs) into a block."""
+def _gather(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
     for b in range(n):
         i = rows[start + b]
         for j in range(nx):
@@ -229,12 +227,39 @@ def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
 
 
 @row_kernel
-def scatter_rows(XB, rows, start, n, x, nx):
-    """Copy the block's ``nx`` states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
+def _scatter(XB, rows, start, n, x, nx):
     for b in range(n):
         i = rows[start + b]
         for j in range(nx):
             x[i, j] = XB[j, b]
+
+
+# The copies into and out of a block have the width of a full block and of a block of one as a
+# compile-time constant, as the RK4 step has (rk4_block_of): a loop of a width known at run
+# time only costs tens of ns to set up, as much as a single env's whole step of one ship.
+
+
+@row_kernel
+def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
+    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows; ``nx`` states,
+    ``nu`` inputs) into a block."""
+    if n == BLOCK:
+        _gather(x, u, c, rows, start, BLOCK, XB, UB, CB, nx, nu)
+    elif n == 1:
+        _gather(x, u, c, rows, start, 1, XB, UB, CB, nx, nu)
+    else:
+        _gather(x, u, c, rows, start, n, XB, UB, CB, nx, nu)
+
+
+@row_kernel
+def scatter_rows(XB, rows, start, n, x, nx):
+    """Copy the block's ``nx`` states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
+    if n == BLOCK:
+        _scatter(XB, rows, start, BLOCK, x, nx)
+    elif n == 1:
+        _scatter(XB, rows, start, 1, x, nx)
+    else:
+        _scatter(XB, rows, start, n, x, nx)
 
 
 @row_kernel
