@@ -19,7 +19,8 @@ This script times, in one process and in interleaved rounds, beside those two:
 It prints million environment steps per second and, for each, the median over the rounds of
 its ratio to CartPoleVectorEnv timed in the same round.
 
-Usage: ``python scripts/bench_heading_bound.py [--envs N] [--repeats N]``.
+Usage: ``python scripts/bench_heading_bound.py [--envs N] [--repeats N] [--plot OUT.png]``
+(``--plot`` draws the ratios as bars, with the target and parity with CartPoleVectorEnv).
 """
 
 from __future__ import annotations
@@ -136,6 +137,7 @@ def main() -> None:
     parser.add_argument("--envs", type=int, default=4096)
     parser.add_argument("--repeats", type=int, default=9)
     parser.add_argument("--steps", type=int, default=100, help="vector steps per repeat")
+    parser.add_argument("--plot", metavar="OUT.png", help="write a bar chart of the ratios")
     args = parser.parse_args()
     n = args.envs - args.envs % (2 * BLOCK)
     if n < 2 * BLOCK:
@@ -178,10 +180,41 @@ def main() -> None:
     print(f"{n} envs, medians of {args.repeats} interleaved rounds of {args.steps} steps")
     print("| step | M env-steps/s | ratio to CartPoleVectorEnv (same round) |")
     print("|---|---:|---:|")
+    ratios = {}
     for name, values in rates.items():
-        ratio = statistics.median(a / b for a, b in zip(values, cart_rates, strict=True))
-        print(f"| {name} | {statistics.median(values) / 1e6:.2f} | {ratio:.2f} |")
+        ratios[name] = statistics.median(a / b for a, b in zip(values, cart_rates, strict=True))
+        print(f"| {name} | {statistics.median(values) / 1e6:.2f} | {ratios[name]:.2f} |")
     pool.shutdown()
+    if args.plot:
+        _plot(ratios, n, args.repeats, args.plot)
+
+
+def _plot(ratios: dict[str, float], n: int, repeats: int, path: str) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 4.6), dpi=110, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    names = [k for k in ratios if k != "CartPoleVectorEnv"]
+    values = [ratios[k] for k in names]
+    colors = ["#b8312f" if k.startswith("NomotoHeading") else "#4a7ab8" for k in names]
+    bars = ax.bar(range(len(names)), values, color=colors, width=0.6, zorder=2)
+    ax.bar_label(bars, fmt="%.2f", fontsize=9)
+    ax.axhline(3.0, color="black", ls="--", lw=1.4, label="target: NomotoHeading >= 3 x")
+    ax.axhline(1.0, color="#555555", lw=0.8, label="parity with CartPoleVectorEnv")
+    ax.set_xticks(range(len(names)), [k.replace(", ", ",\n") for k in names], fontsize=8)
+    ax.set_ylim(0, 3.9)
+    ax.set_ylabel("steps/s / CartPoleVectorEnv steps/s")
+    ax.set_title(
+        f"NomotoHeading vector step ({n} envs) against the attainable heading step\n"
+        f"(median of {repeats} same-round ratios; red: the env, blue: the yardstick)",
+        fontsize=10,
+    )
+    ax.grid(True, axis="y", alpha=0.3, zorder=0)
+    ax.legend(fontsize=8, loc="upper right")
+    fig.savefig(path)
+    print(f"wrote {path}")
 
 
 if __name__ == "__main__":
