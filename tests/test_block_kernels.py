@@ -191,3 +191,44 @@ def test_full_blocks_step_each_model_as_the_single_env_does(name: str) -> None:
             env.step(a[i])
         assert np.array_equal(env.unwrapped.task.x[0], states[i]), i
     assert np.ptp(states[:, 4]) > 0.0  # the ships turn, differently
+
+
+def test_heading_kernel_runs_an_unlisted_shape_as_a_listed_one() -> None:
+    """The heading kernel compiles its loops with the counts of each ship family it lists as
+    constants, and runs any other shape with the counts read at run time: the same numbers.
+
+    One observed state fewer than NomotoHeading's (``r`` only) is not a listed family; it must
+    step the ships, count the steps, reward and flag them, and observe ``[e, r]`` exactly as
+    the listed family does (blow-ups included)."""
+    import gymnasium as gym
+
+    from shipgym.envs import kernels
+
+    n = BLOCK + 5
+    venv = gym.make_vec(
+        "shipgym/NomotoHeading-v0", num_envs=n, vectorization_mode="vector_entry_point"
+    )
+    venv.reset(seed=6)
+    task = venv.unwrapped.task
+    nx, nu = task.x.shape[1], task.u.shape[1]
+    assert (nx, nu, 1, 3) in kernels.HEADING_DIMS and (nx, nu, 1, 2) not in kernels.HEADING_DIMS
+    listed = [
+        np.array(v) if isinstance(v, np.ndarray) else v for v in task._args(True, np.arange(n))
+    ]
+    other = [np.array(v) if isinstance(v, np.ndarray) else v for v in listed]
+    # args: ..., obs_idx 12, ..., obs 16, ..., obs_lo 20, obs_hi 21
+    other[12] = listed[12][:1].copy()
+    other[16] = listed[16][:, :2].copy()
+    other[20], other[21] = listed[20][:2].copy(), listed[21][:2].copy()
+    rng = np.random.default_rng(3)
+    heading = kernels.KERNELS["heading"]
+    for step in range(12):
+        a = rng.uniform(-1.5, 1.5, (n, 1))
+        listed[8][:], other[8][:] = a, a
+        if step == 4:
+            listed[3][7, 2] = other[3][7, 2] = np.nan  # a blow-up in one row
+        assert heading(*listed) == heading(*other) == -1
+        for k, name in ((3, "x"), (15, "steps"), (17, "rew"), (18, "term"), (19, "reason")):
+            np.testing.assert_array_equal(other[k], listed[k], err_msg=f"step {step}: {name}")
+        np.testing.assert_array_equal(other[16], listed[16][:, :2], err_msg=f"step {step}: obs")
+    assert listed[19][7] == kernels.BLOW_UP and np.ptp(listed[3][:, 4]) > 0.0

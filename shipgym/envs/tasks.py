@@ -741,8 +741,7 @@ class RVGHeadingTask(RVGMixin, HeadingTask):
 class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
     """Gunnerus, common pod thrust command, speed setpoints (``shipgym/RVGSpeed-v0``)."""
 
-    obs_dim = 4
-    act_dim = 1
+    act_dim, obs_dim = kernels.SPEED_DIMS
     max_episode_steps = 800
     kernel_name = "speed"
     n_task_draws = 4
@@ -799,8 +798,7 @@ class RVGSpeedTask(RVGMixin, ScheduleMixin, Task):
 class RVGPathTask(RVGMixin, Task):
     """Gunnerus following straight legs between waypoints (``shipgym/RVGPathFollowing-v0``)."""
 
-    obs_dim = 9
-    act_dim = 2
+    act_dim, obs_dim = kernels.PATH_DIMS
     max_episode_steps = 1600
     kernel_name = "path"
     max_waypoints = 16
@@ -953,8 +951,7 @@ class RVGPathTask(RVGMixin, Task):
 class RVGTargetTask(RVGMixin, Task):
     """Gunnerus intercepting a moving target and holding a distance (``RVGTargetTracking-v0``)."""
 
-    obs_dim = 10
-    act_dim = 2
+    act_dim, obs_dim = kernels.TARGET_DIMS
     max_episode_steps = 1600
     kernel_name = "target"
     n_task_draws = 5  # heading, target range, bearing, course, speed

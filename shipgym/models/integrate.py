@@ -19,10 +19,12 @@ loop over the ships of a block compiles to SIMD instructions. The model is chose
 block (:func:`block_rhs`), not once per ship and stage. One ship is a block of one (the
 identification's replays hold their ship as a ``(nx, 1)`` block), so every user of a model
 runs the same function and a ship's result does not depend on the batch it is in. A batch
-held as rows (the envs, :func:`rk4_step_kernel`) is stepped block by block by :func:`rk4_rows`
-(gathered into a block, stepped, scattered back; a full block with its width as a compile-time
-constant and, in the env kernels, by each model's own copy of the step with its number of states
-known too: :func:`full_block_by_model`, :func:`full_block_rvg`). The model-test models (MMG,
+held as rows (the envs, :func:`rk4_step_kernel`) is stepped block by block: gathered into a
+block (:func:`gather_rows`), stepped (:func:`rk4_block_of`: a full block and a block of one with
+their width as a compile-time constant and, in the env kernels, a full block by each model's own
+copy of the step with its number of states known too: :func:`full_block_by_model`,
+:func:`full_block_rvg`) and scattered back (:func:`scatter_rows`); :func:`rk4_rows` does all
+three. The model-test models (MMG,
 VMM), which no environment uses, keep their per-ship functions and :func:`rk4_stages`.
 
 Checked and unchecked entry points
