@@ -38,10 +38,8 @@ FAILING = {
 }
 
 
-def make_pair(
-    env_id: str, mode: AutoresetMode, limit: int = LIMIT, **kwargs: Any
-) -> tuple[VectorEnv, VectorEnv]:
-    native = gym.make_vec(
+def make_native(env_id: str, mode: AutoresetMode, limit: int = LIMIT, **kwargs: Any) -> VectorEnv:
+    return gym.make_vec(
         env_id,
         num_envs=NUM_ENVS,
         vectorization_mode="vector_entry_point",
@@ -49,6 +47,12 @@ def make_pair(
         max_episode_steps=limit,
         **kwargs,
     )
+
+
+def make_pair(
+    env_id: str, mode: AutoresetMode, limit: int = LIMIT, **kwargs: Any
+) -> tuple[VectorEnv, VectorEnv]:
+    native = make_native(env_id, mode, limit, **kwargs)
     sync = gym.make_vec(
         env_id,
         num_envs=NUM_ENVS,
@@ -260,15 +264,7 @@ def test_without_step_info_only_what_autoresets_hand_over(env_id: str, mode: Aut
     failures included) and returns no ``info`` but the finished episodes' ``final_obs``."""
     kwargs = FAILING.get(env_id, {})
     full, _ = make_pair(env_id, mode, **kwargs)
-    lean = gym.make_vec(
-        env_id,
-        num_envs=NUM_ENVS,
-        vectorization_mode="vector_entry_point",
-        autoreset_mode=mode,
-        max_episode_steps=LIMIT,
-        step_info=False,
-        **kwargs,
-    )
+    lean = make_native(env_id, mode, step_info=False, **kwargs)
     assert lean.reset(seed=3)[1] == {}
     full.reset(seed=3)
     full.action_space.seed(3)
