@@ -93,7 +93,8 @@ SPEED_DIMS, PATH_DIMS, TARGET_DIMS = (1, 4), (2, 9), (2, 10)
 #: (states, inputs, actions, observations) of the ship families the heading task sails: a
 #: first- and a second-order Nomoto-family ship and the Gunnerus (another count runs the same
 #: code with its counts known at run time only).
-HEADING_DIMS = ((6, 2, 1, 3), (7, 2, 1, 3), (NX_RVG, NU_RVG, 1, 5))
+FIRST_ORDER, SECOND_ORDER, GUNNERUS = (6, 2, 1, 3), (7, 2, 1, 3), (NX_RVG, NU_RVG, 1, 5)
+HEADING_DIMS = (FIRST_ORDER, SECOND_ORDER, GUNNERUS)
 
 
 @row_kernel
@@ -228,31 +229,36 @@ def _heading(
         m = min(BLOCK, n_rows - start)
         if advance:  # one RK4 call site, between the copies of each family
             if family == 0:
-                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, 6, 2, 1)
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work,
+                                FIRST_ORDER[0], FIRST_ORDER[1], FIRST_ORDER[2])  # fmt: skip
             elif family == 1:
-                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, 7, 2, 1)
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work,
+                                SECOND_ORDER[0], SECOND_ORDER[1], SECOND_ORDER[2])  # fmt: skip
             elif family == 2:
-                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work, NX_RVG, NU_RVG, 1)
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work,
+                                GUNNERUS[0], GUNNERUS[1], GUNNERUS[2])  # fmt: skip
             else:
-                _map_and_gather(
-                    x, u, c, a, u0, B, steps, rows, start, m, work, dims[0], dims[1], dims[2]
-                )
+                _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work,
+                                dims[0], dims[1], dims[2])  # fmt: skip
             rk4_block_of(full_block_by_model, model_id, work[0], work[1], p, work[2], dt, m,
                          work[3])  # fmt: skip
             if family == 0:
-                scatter_rows(work[0], rows, start, m, x, 6)
+                scatter_rows(work[0], rows, start, m, x, FIRST_ORDER[0])
             elif family == 1:
-                scatter_rows(work[0], rows, start, m, x, 7)
+                scatter_rows(work[0], rows, start, m, x, SECOND_ORDER[0])
             elif family == 2:
-                scatter_rows(work[0], rows, start, m, x, NX_RVG)
+                scatter_rows(work[0], rows, start, m, x, GUNNERUS[0])
             else:
                 scatter_rows(work[0], rows, start, m, x, dims[0])
         if family == 0:
-            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, 6, 1)
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason,
+                         FIRST_ORDER[0], FIRST_ORDER[2])  # fmt: skip
         elif family == 1:
-            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, 7, 1)
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason,
+                         SECOND_ORDER[0], SECOND_ORDER[2])  # fmt: skip
         elif family == 2:
-            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, 1)
+            _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason,
+                         GUNNERUS[0], GUNNERUS[2])  # fmt: skip
         else:
             _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, dims[0], dims[2])
         for b in range(m):
@@ -263,10 +269,15 @@ def _heading(
                 for k in range(obs_idx.shape[0]):
                     new[b, 1 + k] = x[i, obs_idx[k]]
                 rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
-        if family == 0 or family == 1:
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, 3)
+        if family == 0:
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason,
+                          FIRST_ORDER[3])  # fmt: skip
+        elif family == 1:
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason,
+                          SECOND_ORDER[3])  # fmt: skip
         elif family == 2:
-            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, 5)
+            _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason,
+                          GUNNERUS[3])  # fmt: skip
         else:
             _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason, dims[3])
     return -1
