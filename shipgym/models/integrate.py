@@ -174,8 +174,8 @@ def rk4_block(model_id, X, U, p, C, h, n, W):
     _rk4(block_rhs, model_id, X.shape[0], X, U, p, C, h, n, W)
 
 
-# The RK4 step of a full block of BLOCK ships (rk4_rows' first argument): the block's width is a
-# compile-time constant in all three, the number of states too in the per-model ones.
+# The RK4 step of a full block of BLOCK ships (rk4_block_of's first argument): the block's
+# width is a compile-time constant in all three, the number of states too in the per-model ones.
 _NX_FIRST, _NX_SECOND, _NX_RVG = STATE_COUNTS[NOMOTO1], STATE_COUNTS[NOMOTO2], STATE_COUNTS[RVG3DOF]
 
 
