@@ -62,8 +62,7 @@ def _models() -> None:
 def _sysid() -> None:
     from shipgym.models import make_model
     from shipgym.sysid import generate_record
-    from shipgym.sysid.families.base import window_starts
-    from shipgym.sysid.families.nomoto import lag_filter
+    from shipgym.sysid.families.base import lag_filter, window_starts
     from shipgym.sysid.families.rvg import replay_windows
     from shipgym.sysid.fit import replay
 

@@ -13,7 +13,8 @@ import pytest
 from shipgym.sysid import identify
 from shipgym.sysid.data import Record
 from shipgym.sysid.families import FAMILIES
-from shipgym.sysid.families.nomoto import NOMOTO_BASES, NOMOTO_EFFECTS, lag_filter
+from shipgym.sysid.families.base import lag_filter
+from shipgym.sysid.families.nomoto import NOMOTO_BASES, NOMOTO_EFFECTS
 from shipgym.sysid.generator import EFFECTS_BY_BASE, generate_record
 
 DT = 0.5

@@ -17,6 +17,16 @@ term, its parameters with bounds, its source). The engine runs one loop over any
 
 Families register themselves in :data:`FAMILIES` under their model names (the ``--model`` of
 ``shipgym identify``); a new family is one new module and one :func:`register` call.
+
+Causes shared by the families
+-----------------------------
+An effect whose physics does not depend on the hull model (a rudder zero error, a steering gear
+that lags the recorded rudder, a transport delay, a current, the wind) is defined once in
+:data:`CAUSES`; a family says which of them it can represent (:func:`causes`) and adds its own
+hull-specific ones. The actuator causes act on the recorded rudder before any model sees it,
+through one function every family uses (:func:`actual_rudder`: :func:`shift` for the delay,
+:func:`lag_filter` for the steering gear, seed 002 eq. 2), and the fitted models simulate them
+the same way (:class:`shipgym.models.SteeringGear`, :class:`shipgym.models.delay.DelayLine`).
 """
 
 from __future__ import annotations
@@ -24,26 +34,36 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from shipgym.models import Nomoto1Params, SteeringGear, make_model
+from shipgym.models._jit import kernel
+from shipgym.models.integrate import NOMOTO1, rk4_block
+from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 
 __all__ = [
+    "ACTUATOR_CAUSES",
     "BIC_MARGIN",
+    "CAUSES",
     "FAMILIES",
     "TIE_FRACTION",
     "Candidate",
     "Effect",
     "ModelFamily",
+    "actual_rudder",
     "bic",
+    "causes",
     "errors",
     "get_family",
     "jsonable",
+    "lag_filter",
     "ljung_box",
     "register",
+    "shift",
     "window_starts",
     "wrap",
     "xcorr",
@@ -84,6 +104,78 @@ class Effect:
     def n_added(self) -> int:
         """Number of parameters the effect adds (the parsimony rule counts these)."""
         return len(self.parameters)
+
+
+LAG_BOUNDS = (0.1, 40.0)
+"""Bounds [s] of an identified steering-gear time constant ``T_d``."""
+
+DELAY_BOUNDS = (0.0, 15.0)
+"""Bounds [s] of an identified input delay ``tau``."""
+
+RUDDER_OFFSET_BOUNDS = (-math.radians(5.0), math.radians(5.0))
+"""Bounds [rad] of an identified rudder zero error ``delta0``."""
+
+CAUSES: dict[str, Effect] = {
+    e.name: e
+    for e in (
+        Effect(
+            "rudder_offset",
+            "delta = delta_recorded + delta0",
+            ("delta0",),
+            {"delta0": RUDDER_OFFSET_BOUNDS},
+            "a rudder zero error (indicator or feedback misaligned); seed 000 (regression "
+            "constant c, delta0 = c / b); seed 002 eq. 4",
+        ),
+        Effect(
+            "rudder_lag",
+            "T_d delta' + delta = delta_recorded (the ship's angle and rate limits)",
+            ("T_d",),
+            {"T_d": LAG_BOUNDS},
+            "seed 002 eq. 2: the recorded rudder is the order of a first-order steering gear "
+            "(shipgym.models.SteeringGear)",
+        ),
+        Effect(
+            "input_delay",
+            "delta(t) = delta_recorded(t - tau)",
+            ("tau",),
+            {"tau": DELAY_BOUNDS},
+            "a transport delay between the rudder log and the ship (logging, hydraulics)",
+        ),
+        Effect(
+            "current",
+            "nu_r = nu - R(psi)^T [V_n, V_e, 0]",
+            ("V_n", "V_e"),
+            {"V_n": (-2.0, 2.0), "V_e": (-2.0, 2.0)},
+            "a steady, uniform, irrotational current: seed 001 eq. 7-12, seed 003 eq_nu_r",
+        ),
+        Effect(
+            "wind",
+            "X_wc (V_w/U)^2 cos g, Y_ws (V_w/U)^2 sin g, N_w2 (V_w/U)^2 sin 2g",
+            ("X_wc", "Y_ws", "N_w2"),
+            {},
+            "apparent-wind loads with the angular forms of Isherwood (1972) and Fossen (2011, "
+            "eq. 8.23); needs the record's wind channels",
+        ),
+    )
+}
+"""Causes whose physics does not depend on the hull model, each defined once (module
+docstring); a family takes those it can represent with :func:`causes`."""
+
+ACTUATOR_CAUSES: tuple[str, ...] = ("rudder_offset", "rudder_lag", "input_delay")
+"""The causes that act on the recorded rudder (:func:`actual_rudder`)."""
+
+
+def causes(*names: str, **representations: Mapping[str, Any]) -> dict[str, Effect]:
+    """The shared definitions of ``names`` for a family's catalogue, in that order.
+
+    ``representations`` maps a cause to the fields a family writes differently (its own term or
+    parameter names for the same physics, e.g. the Norrbin model's rudder offset as a yaw bias
+    ``n0``), applied with :func:`dataclasses.replace`.
+    """
+    unknown = [n for n in (*names, *representations) if n not in CAUSES]
+    if unknown:
+        raise ValueError(f"unknown causes {unknown}; expected some of {tuple(CAUSES)}")
+    return {n: replace(CAUSES[n], **representations.get(n, {})) for n in names}
 
 
 @dataclass
@@ -321,3 +413,128 @@ def jsonable(obj: Any) -> Any:
     if isinstance(obj, float | np.floating):
         return float(obj) if math.isfinite(obj) else None
     return obj
+
+
+# --------------------------------------------------------------------------------------------
+# the recorded rudder and the rudder the ship feels
+
+
+@kernel
+def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
+    """:meth:`ShipModel.simulate` of a ``nomoto1`` model with inputs ``(cmd[k], 0)``, compiled.
+
+    The same RK4 steps (:func:`shipgym.models.integrate.rk4_block`, no current); writes the
+    rudder state ``x[IDELTA]`` at every step into ``out`` (length ``cmd.size + 1``).
+    """
+    nx = x0.shape[0]
+    x = np.empty((nx, 1))  # a block of one ship (states x ships)
+    for j in range(nx):
+        x[j, 0] = x0[j]
+    u = np.zeros((2, 1))
+    c = np.zeros((2, 1))
+    work = np.empty((3, nx, 1))
+    out[0] = x[IDELTA, 0]
+    for k in range(cmd.shape[0]):
+        u[0, 0] = cmd[k]
+        rk4_block(NOMOTO1, x, u, p, c, h, 1, work)
+        out[k + 1] = x[IDELTA, 0]
+
+
+def lag_filter(
+    t: np.ndarray,
+    u: np.ndarray,
+    T_d: float,
+    y0: float | None = None,
+    gear: SteeringGear | None = None,
+) -> np.ndarray:
+    """The recorded rudder ``u`` as a command through the project's steering gear.
+
+    :class:`shipgym.models.SteeringGear` with time constant ``T_d`` and the angle and rate
+    limits of ``gear`` (default 35 deg, 2.32 deg/s, seed 002 eq. 2), simulated with the steps
+    of :meth:`ShipModel.simulate` (compiled) on a fine grid (step at most 0.1 s, the command held
+    over each step) and read back at ``t``.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Sample times [s].
+    u : numpy.ndarray
+        Recorded rudder [rad], the gear's command.
+    T_d : float
+        Gear time constant [s].
+    y0 : float, optional
+        Initial actual rudder [rad] (``u[0]`` by default).
+    gear : SteeringGear, optional
+        The ship's angle and rate limits (its time constant is replaced by ``T_d``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The actual rudder [rad] at ``t``.
+    """
+    dt = float(np.median(np.diff(t)))
+    m = max(1, math.ceil(dt / 0.1 - 1e-9))
+    h = dt / m
+    n = max(1, math.ceil((t[-1] - t[0]) / h - 1e-9))
+    tf = t[0] + h * np.arange(n + 1)
+    gear = replace(gear or SteeringGear(), time_constant=T_d)
+    model = make_model("nomoto1", Nomoto1Params(), gear=gear)
+    x0 = np.zeros(model.nx)
+    x0[IDELTA] = u[0] if y0 is None else y0
+    rudder = np.empty(n + 1)
+    _gear_kernel(x0, np.interp(tf[:-1], t, u), model.p, h, rudder)
+    return np.interp(t, tf, rudder)
+
+
+def shift(t: np.ndarray, u: np.ndarray, tau: float) -> np.ndarray:
+    """``u(t - tau)`` by linear interpolation, the first sample held before the start (the
+    :class:`shipgym.models.delay.DelayLine` of a simulated ship)."""
+    return np.interp(t - tau, t, u, left=u[0])
+
+
+def actual_rudder(
+    t: np.ndarray,
+    delta: np.ndarray,
+    *,
+    rudder_offset: float = 0.0,
+    rudder_lag: float | None = None,
+    input_delay: float = 0.0,
+    gear: SteeringGear | None = None,
+    y0: float | None = None,
+) -> np.ndarray:
+    """The rudder the ship feels, from the recorded one, under the actuator causes.
+
+    The recorded rudder is delayed by ``input_delay`` (:func:`shift`), passed as the order of a
+    steering gear of time constant ``rudder_lag`` (:func:`lag_filter`, with ``gear``'s limits
+    and initial angle ``y0``) and shifted by the zero error ``rudder_offset``, in that order (a
+    simulated ship: :class:`~shipgym.models.delay.DelayLine`, then its gear, the offset on its
+    order).
+
+    Parameters
+    ----------
+    t, delta : numpy.ndarray
+        Sample times [s] and recorded rudder [rad].
+    rudder_offset : float
+        Zero error ``delta0`` [rad].
+    rudder_lag : float, optional
+        Gear time constant ``T_d`` [s] (None: the record is the actual angle).
+    input_delay : float
+        Delay ``tau`` [s] (>= 0).
+    gear : SteeringGear, optional
+        Angle and rate limits of the ship's gear.
+    y0 : float, optional
+        Initial actual rudder of the lag [rad].
+
+    Returns
+    -------
+    numpy.ndarray
+    """
+    d = np.asarray(delta, dtype=np.float64)
+    if input_delay > 0.0:
+        d = shift(t, d, input_delay)
+    if rudder_offset:
+        d = d + rudder_offset
+    if rudder_lag is not None and rudder_lag > 0.0:
+        d = lag_filter(t, d, rudder_lag, y0, gear)
+    return d
+

@@ -105,19 +105,21 @@ import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
-from shipgym.models import BechParams, Nomoto1Params, NorrbinParams, SteeringGear, make_model
-from shipgym.models._jit import kernel
-from shipgym.models.integrate import NOMOTO1, rk4_block
+from shipgym.models import BechParams, NorrbinParams, SteeringGear
 from shipgym.models.model_file import nomoto_document
-from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
+    DELAY_BOUNDS,
+    LAG_BOUNDS,
     Candidate,
     Effect,
     ModelFamily,
+    causes,
     errors,
+    lag_filter,
     ljung_box,
     register,
+    shift,
     window_starts,
     wrap,
     xcorr,
@@ -169,8 +171,6 @@ AUTO_WINDOW_DURATION = 1000.0
 AUTO_WINDOW_S = 300.0
 """Window [s] for long records (``window_s="auto"``)."""
 
-_LAG_BOUNDS = (0.1, 40.0)
-_DELAY_BOUNDS = (0.0, 15.0)
 _SEARCH_SAMPLES = 2000
 """Largest number of samples of the fits inside the ``T_d`` / ``tau`` searches."""
 _SEARCH_XATOL = 0.05
@@ -200,19 +200,31 @@ def _catalogue(base: str) -> dict[str, Effect]:
     second = base in _SECOND_ORDER_BASES
     offset = {"nomoto1": "delta0", "nomoto2": "delta0", "norrbin": "n0", "bech": "b0"}[base]
     coef = "b" if second else "n"
-    effects = [
-        Effect(
-            "rudder_offset",
-            {
+    shared = causes(
+        "rudder_offset",
+        "rudder_lag",
+        "input_delay",
+        "current",
+        rudder_offset={
+            "term": {
                 "delta0": "delta -> delta + delta0",
                 "n0": "H(r) += n0 (n0 = -K delta0)",
                 "b0": "H_B(r) += b0 (b0 = -delta0)",
             }[offset],
-            (offset,),
-            {},
-            "seed 000 (regression constant c, delta0 = c / b); seed 002 eq. 4 (a0 = -n0 / T: "
-            "hull asymmetry, wind, waves, current)",
-        ),
+            "parameters": (offset,),
+            "bounds": {},
+        },
+        rudder_lag={
+            "term": "T_d delta' + delta = delta_recorded (|delta| <= 35 deg, "
+            "|delta'| <= 2.32 deg/s)"
+        },
+        current={
+            "term": "x' = U cos psi + V_n, y' = U sin psi + V_e (the yaw does not see it)",
+            "bounds": {},
+        },
+    )
+    effects = [
+        shared["rudder_offset"],
         Effect(
             "yaw_nonlinearity",
             f"r -> H(r) = {coef}3 r^3 + {coef}2 r|r| + {coef}1 r (|{coef}1 K| = 1)",
@@ -220,27 +232,9 @@ def _catalogue(base: str) -> dict[str, Effect]:
             {},
             "seed 002 eq. 1 (Norrbin); seed 004 eq. 3 (Bech, with second_order)",
         ),
-        Effect(
-            "rudder_lag",
-            "T_d delta' + delta = delta_recorded (|delta| <= 35 deg, |delta'| <= 2.32 deg/s)",
-            ("T_d",),
-            {"T_d": _LAG_BOUNDS},
-            "seed 002 eq. 2 (steering gear, shipgym.models.SteeringGear)",
-        ),
-        Effect(
-            "input_delay",
-            "delta(t) = delta_recorded(t - tau)",
-            ("tau",),
-            {"tau": _DELAY_BOUNDS},
-            "a transport delay between the rudder log and the ship",
-        ),
-        Effect(
-            "current",
-            "x' = U cos psi + V_n, y' = U sin psi + V_e",
-            ("V_n", "V_e"),
-            {},
-            "seed 001 eq. 7-12 (steady, uniform current); dead reckoning of the track",
-        ),
+        shared["rudder_lag"],
+        shared["input_delay"],
+        shared["current"],
         Effect(
             "second_order",
             "T1 T2 r'' + (T1 + T2) r' + r = K (delta + T3 delta') (T1 replaces T)",
@@ -331,64 +325,6 @@ class _Fitted:
 # rudder input: steering-gear lag and delay
 
 
-@kernel
-def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
-    """:meth:`ShipModel.simulate` of a ``nomoto1`` model with inputs ``(cmd[k], 0)``, compiled.
-
-    The same RK4 steps (:func:`shipgym.models.integrate.rk4_block`, no current); writes the
-    rudder state ``x[IDELTA]`` at every step into ``out`` (length ``cmd.size + 1``).
-    """
-    nx = x0.shape[0]
-    x = np.empty((nx, 1))  # a block of one ship (states x ships)
-    for j in range(nx):
-        x[j, 0] = x0[j]
-    u = np.zeros((2, 1))
-    c = np.zeros((2, 1))
-    work = np.empty((3, nx, 1))
-    out[0] = x[IDELTA, 0]
-    for k in range(cmd.shape[0]):
-        u[0, 0] = cmd[k]
-        rk4_block(NOMOTO1, x, u, p, c, h, 1, work)
-        out[k + 1] = x[IDELTA, 0]
-
-
-def lag_filter(t: np.ndarray, u: np.ndarray, T_d: float, y0: float | None = None) -> np.ndarray:
-    """The recorded rudder ``u`` as a command through the project's steering gear.
-
-    :class:`shipgym.models.SteeringGear` with time constant ``T_d`` and the default angle and
-    rate limits (35 deg, 2.32 deg/s, seed 002 eq. 2), simulated with the steps of
-    :meth:`ShipModel.simulate` (compiled) on a fine grid (step at most 0.1 s, the command held
-    over each step) and read back at ``t``.
-
-    Parameters
-    ----------
-    t : numpy.ndarray
-        Sample times [s].
-    u : numpy.ndarray
-        Recorded rudder [rad], the gear's command.
-    T_d : float
-        Gear time constant [s].
-    y0 : float, optional
-        Initial actual rudder [rad] (``u[0]`` by default).
-
-    Returns
-    -------
-    numpy.ndarray
-        The actual rudder [rad] at ``t``.
-    """
-    dt = float(np.median(np.diff(t)))
-    m = max(1, math.ceil(dt / 0.1 - 1e-9))
-    h = dt / m
-    n = max(1, math.ceil((t[-1] - t[0]) / h - 1e-9))
-    tf = t[0] + h * np.arange(n + 1)
-    model = make_model("nomoto1", Nomoto1Params(), gear=SteeringGear(time_constant=T_d))
-    x0 = np.zeros(model.nx)
-    x0[IDELTA] = u[0] if y0 is None else y0
-    rudder = np.empty(n + 1)
-    _gear_kernel(x0, np.interp(tf[:-1], t, u), model.p, h, rudder)
-    return np.interp(t, tf, rudder)
-
-
 def _initial_rudder(fit: FitResult, t: np.ndarray, r: np.ndarray) -> float:
     """Rudder the ship feels at ``t[0]`` from the base fit: ``(T r'(0) + r(0)) / K - delta0``.
 
@@ -413,18 +349,13 @@ def _initial_rudder(fit: FitResult, t: np.ndarray, r: np.ndarray) -> float:
     return float(np.clip((T * rd0 + r0) / K - fit.delta0, -lim, lim))
 
 
-def _shift(t: np.ndarray, u: np.ndarray, tau: float) -> np.ndarray:
-    """``u(t - tau)`` by linear interpolation, the first sample held before the start."""
-    return np.interp(t - tau, t, u, left=u[0])
-
-
 def _input(
     cfg: _Config, t: np.ndarray, delta: np.ndarray, T_d: float, tau: float, y0: float | None = None
 ) -> np.ndarray:
     """The rudder the model sees: the record delayed by ``tau``, then through the gear."""
     d = delta
     if cfg.delay and tau > 0.0:
-        d = _shift(t, d, tau)
+        d = shift(t, d, tau)
     if cfg.lag and T_d > 0.0:
         d = lag_filter(t, d, T_d, y0)
     return d
@@ -552,11 +483,11 @@ def _fit_config(
             if memo is not None and key in memo:
                 tau, warm = memo[key]
             else:
-                tau, warm = search(lambda s, w: fit_with(0.0, s, sub, search_kw, w), _DELAY_BOUNDS)
+                tau, warm = search(lambda s, w: fit_with(0.0, s, sub, search_kw, w), DELAY_BOUNDS)
                 if memo is not None:
                     memo[key] = (tau, warm)
         if cfg.lag:
-            T_d, warm = search(lambda s, w: fit_with(s, tau, sub, search_kw, w), _LAG_BOUNDS)
+            T_d, warm = search(lambda s, w: fit_with(s, tau, sub, search_kw, w), LAG_BOUNDS)
     return _Fitted(cfg, reweighted(T_d, tau, warm), T_d, tau, y0)
 
 
@@ -872,7 +803,7 @@ def residual_diagnostics(
         fit.model_name, p, t, lag_filter(t, delta, 2.0 * dt) + fit.delta0, fit.x0
     )[:, 4]
     sig["input_delay"] = replay(
-        fit.model_name, p, t, _shift(t, delta, 2.0 * dt) + fit.delta0, fit.x0
+        fit.model_name, p, t, shift(t, delta, 2.0 * dt) + fit.delta0, fit.x0
     )[:, 4]
     # yaw nonlinearity: the cubic damping term r^3 acting as an extra rudder -r^3 n3/K
     if "K" in names and p.K != 0:
