@@ -181,10 +181,11 @@ class ShipModel:
             and delay >= 0.0
         ):
             raise ValueError(f"input_delay must be a finite time >= 0 s, got {delay!r}")
-        if delay and self.name not in NOMOTO_MODEL_NAMES:
+        if delay and self.name not in (*NOMOTO_MODEL_NAMES, "vmm", "kvlcc2"):
             raise ValueError(
                 f"input_delay applies to the rudder command of the Nomoto family "
-                f"{NOMOTO_MODEL_NAMES}, not to model {self.name!r}"
+                f"{NOMOTO_MODEL_NAMES} and the 3-DOF models vmm and kvlcc2, not to model "
+                f"{self.name!r}"
             )
         set_(self, "input_delay", float(delay))
         set_(self, "model_id", integrate.MODEL_IDS[self.name])
@@ -668,7 +669,7 @@ def make_model(
                 "model 'vmm' takes VMMParams or the path of a fitted model's JSON "
                 f"(shipgym identify --model vmm:... --json FILE), got {type(params).__name__}"
             )
-        return ShipModel(name, params)
+        return ShipModel(name, params, input_delay=input_delay)
     three_dof = {"rvg3dof": RVGParams, "kvlcc2": MMGParams}
     expected = three_dof.get(name) or _DEFAULT_YAW[name]
     if name == "rvg3dof" and is_model_file(params):  # an identified Gunnerus
@@ -691,7 +692,7 @@ def make_model(
     elif not isinstance(params, expected):
         raise ValueError(f"model {name!r} takes {expected.__name__}, got {type(params).__name__}")
     if name in three_dof:
-        if input_delay:
-            raise ValueError(f"input_delay applies to the Nomoto family, not to {name!r}")
-        return ShipModel(name, params)
+        if input_delay and name == "rvg3dof":
+            raise ValueError(f"input_delay applies to a rudder order, not to {name!r}'s pods")
+        return ShipModel(name, params, input_delay=input_delay)
     return ShipModel(name, params, gear or SteeringGear(), surge or SurgeModel(), input_delay)

@@ -30,8 +30,10 @@ fit.json`` and ``shipgym design fit.json``:
   as ``azimuth_offset`` (the pods turn to the order plus it); the record's current and sway
   offset (a log or antenna misalignment) are kept for information, ``current_m_s`` and
   ``sway_offset_m_s``. The RVG envs take it as ``params="fit.json"``.
-* ``"vmm"`` (seed 003's general 3-DOF model, :meth:`VMMParams.load`) and ``"kvlcc2"`` (the MMG
-  model with refined derivatives, :class:`MMGParams` fields).
+* ``"vmm"`` (seed 003's general 3-DOF model, :meth:`VMMParams.load`; an identified rudder zero
+  error is its ``rudder_offset``, a steering-gear lag its ``rudder_time_constant`` with
+  ``direct_rudder`` false, a transport delay ``input_delay_s``, the model's ``input_delay``) and
+  ``"kvlcc2"`` (the MMG model with refined derivatives, :class:`MMGParams` fields).
 """
 
 from __future__ import annotations
@@ -273,13 +275,15 @@ def load_model(source: str | os.PathLike[str] | Mapping[str, Any]) -> ShipModel:
     if isinstance(data.get("rvg3dof"), Mapping):
         return _rvg(data["rvg3dof"], where)
     if isinstance(data.get("vmm"), Mapping):
-        vmm = {k: v for k, v in data["vmm"].items() if k != "current"}
-        return make_model("vmm", VMMParams.from_dict(vmm))
+        vmm = {k: v for k, v in data["vmm"].items() if k not in ("current", "input_delay_s")}
+        delay = float(data["vmm"].get("input_delay_s") or 0.0)
+        return make_model("vmm", VMMParams.from_dict(vmm), input_delay=delay)
     if isinstance(data.get("kvlcc2"), Mapping):
         names = {f.name for f in fields(MMGParams)}
+        delay = float(data["kvlcc2"].get("input_delay_s") or 0.0)
         return make_model("kvlcc2", MMGParams(**{
             k: v for k, v in data["kvlcc2"].items() if k in names
-        }))  # fmt: skip
+        }), input_delay=delay)  # fmt: skip
     model = data.get("model")
     hint = (
         f" (a {model!r} fit; its model is not written to a model file)"

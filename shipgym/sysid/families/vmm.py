@@ -38,19 +38,20 @@ accelerations of free-running manoeuvres are too small and too correlated with t
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from scipy.linalg import qr
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, minimize_scalar
 from scipy.signal import savgol_filter
 
 from shipgym.models._jit import kernel
 from shipgym.models.base import make_model
 from shipgym.models.integrate import KVLCC2, VMM, model_test_row, rk4_stages
 from shipgym.models.mmg import KVLCC2_SCALE, MMGParams, pack_mmg
+from shipgym.models.nomoto import SteeringGear
 from shipgym.models.vmm import (
     P_INV,
     P_MU,
@@ -63,10 +64,14 @@ from shipgym.models.vmm import (
 )
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
+    ACTUATOR_CAUSES,
+    CAUSES,
     Candidate,
     Effect,
     ModelFamily,
+    actual_rudder,
     bic,
+    causes,
     register,
     window_starts,
     wrap,
@@ -120,20 +125,15 @@ _STATE_COL = {"x": 0, "y": 1, "psi": 2, "u": 3, "v": 4, "r": 5}
 VMM_EFFECTS: dict[str, Effect] = {
     "asymmetry": Effect(
         "asymmetry",
-        "Y_0, N_0 (constant side force and yaw moment, prime)",
+        "Y_0, N_0 (the term set's straight-running side force and yaw moment, prime: "
+        "ASYMMETRY_TERMS)",
         ("Y_0", "N_0"),
         {},
-        "the single propeller's side force and a rudder zero error (the seed's Y0, N0): the "
-        "MARIN KVLCC2 runs hold about -0.8 deg of rudder to run straight; reported also as the "
+        "the single propeller's side force (the seed's Y0, N0): a force that does not grow "
+        "with the rudder's inflow as a rudder zero error does; reported also as the "
         "equivalent rudder offset -N_0 / N_d",
     ),
-    "current": Effect(
-        "current",
-        "hydrodynamics in nu - nu_c, nu_c = R(psi)^T [V_x, V_y] (seed 003 eq_nu_r)",
-        ("V_x", "V_y"),
-        {"V_x": (-2.0, 2.0), "V_y": (-2.0, 2.0)},
-        "a constant, irrotational current (seed 003)",
-    ),
+    **causes("rudder_offset", "rudder_lag", "input_delay", "current"),
     "rudder_slipstream": Effect(
         "rudder_slipstream",
         "Y_Td T' delta, N_Td T' delta",
@@ -142,16 +142,22 @@ VMM_EFFECTS: dict[str, Effect] = {
         "the rudder in the propeller slipstream: its force grows with the thrust loading (MMG "
         "eq. 40-42; the seed's Y_thrustdelta)",
     ),
-    "wind": Effect(
-        "wind",
-        "X_wc (V_w/U)^2 cos g, Y_ws (V_w/U)^2 sin g, N_w2 (V_w/U)^2 sin 2g",
-        ("X_wc", "Y_ws", "N_w2"),
-        {},
-        "apparent-wind loads with the angular forms of Isherwood (1972) and Fossen (2011, "
-        "eq. 8.23); needs the record's wind channels",
-    ),
+    "wind": CAUSES["wind"],
 }
-"""The effects of the VMM family (module docstring)."""
+"""The effects of the VMM family (module docstring): the shared causes
+(:data:`~shipgym.sysid.families.base.CAUSES`) and the hull's own terms."""
+
+ACTUATOR_SEARCH_LENGTHS = 3.0
+"""Largest steering-gear time constant and input delay searched, in ship lengths of travel
+(``3 L / U``: 18 s on the 7 m KVLCC2 model; the shared bounds cap it at full scale)."""
+
+ASYMMETRY_TERMS: tuple[str, ...] = tuple(
+    f"{e}_{t}" for e in "YN" for t in ("0", "u", "0u", "0uu", "T")
+)
+"""Terms that give a side force and yaw moment in straight running (no sway, yaw or rudder):
+the loop's base model leaves them out, and ``asymmetry`` adds those of the term set (``Y_0,
+N_0`` for a set without), so that a rudder zero error, which such terms would otherwise absorb,
+and a propeller side force compete as causes."""
 
 _EFFECT_TERMS = {
     "asymmetry": ("Y_0", "N_0"),
@@ -543,6 +549,26 @@ def _replay_kernel(model_id, t, starts, ends, x0, inputs, p, c, out):  # pragma:
                 out[k + 1, j] = x[0, j]
 
 
+def felt_rudder(
+    t: np.ndarray, delta: np.ndarray, actuators: Mapping[str, float], gear: SteeringGear
+) -> np.ndarray:
+    """The rudder the ship felt under the actuator causes' parameters ``actuators``
+    (``delta0``, ``T_d``, ``tau``; :func:`~shipgym.sysid.families.base.actual_rudder`)."""
+    return actual_rudder(
+        t,
+        delta,
+        rudder_offset=actuators.get("delta0", 0.0),
+        rudder_lag=actuators.get("T_d"),
+        input_delay=actuators.get("tau", 0.0),
+        gear=gear,
+    )
+
+
+def _gear_of(params: VMMParams) -> SteeringGear:
+    """The angle and rate limits of the ship's steering gear."""
+    return SteeringGear(max_angle=params.max_rudder, max_rate=params.rudder_rate)
+
+
 @dataclass
 class _Replay:
     """Runs thinned to the replay step and cut into windows, concatenated for the kernel."""
@@ -555,14 +581,38 @@ class _Replay:
     x0: np.ndarray
     run_of: np.ndarray  # run index of every sample
     first: np.ndarray  # True at window starts (not scored)
+    sources: list[tuple[np.ndarray, np.ndarray, np.ndarray]]  # per run: t, delta, thinned rows
+    gear: SteeringGear  # the ship's rudder angle and rate limits
+    _rudders: dict[tuple[tuple[str, float], ...], np.ndarray] = field(
+        default_factory=dict, repr=False
+    )
 
     def run_mask(self, runs: Sequence[int]) -> np.ndarray:
         """Scored samples of the runs ``runs``."""
         return np.isin(self.run_of, list(runs)) & ~self.first
 
+    def inputs_with(self, actuators: Mapping[str, float] | None) -> np.ndarray:
+        """The replay inputs with the rudder the ship feels under ``actuators`` (``delta0``,
+        ``T_d``, ``tau``: :func:`~shipgym.sysid.families.base.actual_rudder` of each run's
+        full-rate record, then thinned); the recorded inputs without."""
+        if not actuators:
+            return self.inputs
+        key = tuple(sorted(actuators.items()))
+        column = self._rudders.get(key)
+        if column is None:
+            column = np.concatenate([
+                felt_rudder(t, delta, actuators, self.gear)[sel] for t, delta, sel in self.sources
+            ])
+            if len(self._rudders) > 64:  # a search's values: keep the newest only
+                self._rudders.clear()
+            self._rudders[key] = column
+        inputs = self.inputs.copy()
+        inputs[:, 0] = column
+        return inputs
+
 
 def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | None) -> _Replay:
-    parts_t, parts_u, parts_m, run_of = [], [], [], []
+    parts_t, parts_u, parts_m, run_of, sources = [], [], [], [], []
     starts, ends, x0 = [], [], []
     n0 = 0
     for i, run in enumerate(runs):
@@ -571,6 +621,7 @@ def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | Non
         stride = max(1, int(STEP_LENGTHS * params.length / max(speed, 1e-3) / h))
         sel = np.arange(0, run.t.size, stride)
         t = run.t[sel]
+        sources.append((run.t, run.delta, sel))
         parts_t.append(t)
         parts_u.append(
             np.column_stack((run.delta[sel], run.thrust[sel], run.wind[sel], run.rps[sel]))
@@ -588,9 +639,10 @@ def _build_replay(runs: Sequence[_Run], params: VMMParams, window_s: float | Non
     starts_arr = np.array(starts, dtype=np.int64)
     first = np.zeros(n0, dtype=bool)
     first[starts_arr] = True
+    gear = _gear_of(params)
     return _Replay(
         np.concatenate(parts_t), np.concatenate(parts_u), np.concatenate(parts_m), starts_arr,
-        ends_arr, np.array(x0), np.concatenate(run_of), first,
+        ends_arr, np.array(x0), np.concatenate(run_of), first, sources, gear,
     )  # fmt: skip
 
 
@@ -599,17 +651,20 @@ def replay(
     params: VMMParams | MMGParams,
     current: Sequence[float] = (0.0, 0.0),
     x0: np.ndarray | None = None,
+    actuators: Mapping[str, float] | None = None,
 ) -> np.ndarray:
     """``(n, 6)`` simulated ``x, y, psi, u, v, r`` of the replay windows with the measured
-    rudder, each from the measured state (or from the rows of ``x0``); a VMM or the MMG model
-    (driven by the measured propeller revolutions)."""
+    rudder (under the actuator causes ``actuators``: :meth:`_Replay.inputs_with`), each from
+    the measured state (or from the rows of ``x0``); a VMM or the MMG model (driven by the
+    measured propeller revolutions)."""
     out = np.empty((rp.t.size, 7))
     if isinstance(params, MMGParams):
         model_id, p = KVLCC2, pack_mmg(params)
     else:
         model_id, p = VMM, pack_vmm(replace(params, direct_rudder=True))
-    _replay_kernel(model_id, rp.t, rp.starts, rp.ends, rp.x0 if x0 is None else x0, rp.inputs,
-                   p, np.asarray(current, dtype=np.float64), out)  # fmt: skip
+    _replay_kernel(model_id, rp.t, rp.starts, rp.ends, rp.x0 if x0 is None else x0,
+                   rp.inputs_with(actuators), p, np.asarray(current, dtype=np.float64),
+                   out)  # fmt: skip
     return out[:, :6]
 
 
@@ -640,7 +695,7 @@ class VMMFit:
     params : VMMParams
         The model (coefficients, rudder offset).
     current : tuple of float
-        The current ``(V_x, V_y)`` [m/s] of the records.
+        The current ``(V_n, V_e)`` [m/s] of the records.
     effects : tuple of str
         Effects in the model.
     regression : RegressionResult
@@ -648,7 +703,13 @@ class VMMFit:
     refined : bool
         Whether the output-error refinement ran.
     stderr : dict
-        Standard errors of the coefficients (the regression's Newey-West values).
+        Standard errors of the coefficients (the regression's Newey-West values, the
+        refinement's for the actuator parameters).
+    actuators : dict
+        The actuator causes' parameters (``delta0`` [rad], ``T_d`` [s], ``tau`` [s]) of the
+        effects in the model: the rudder the ship felt (:meth:`_Replay.inputs_with`).
+    term_set : str
+        The term set (a key of :data:`~shipgym.models.vmm.TERM_SETS`).
     """
 
     params: VMMParams
@@ -657,24 +718,53 @@ class VMMFit:
     regression: RegressionResult
     refined: bool = False
     stderr: dict[str, float] = field(default_factory=dict)
+    actuators: dict[str, float] = field(default_factory=dict)
+    term_set: str = ""
 
     @property
     def values(self) -> dict[str, float]:
         """Every fitted number: coefficients, and the effects' own parameters."""
         out = dict(self.params.coefficients)
         if "current" in self.effects:
-            out["V_x"], out["V_y"] = self.current
-        return out
+            out["V_n"], out["V_e"] = self.current
+        return out | self.actuators
 
     def model_file(self) -> dict[str, Any]:
-        """The fitted model as :meth:`VMMParams.load` reads it (``{"vmm": ...}``)."""
-        return {"vmm": self.params.to_dict() | {"current": self.current}}
+        """The fitted model as :meth:`VMMParams.load` reads it (``{"vmm": ...}``), its
+        actuator causes in the model's terms (:mod:`shipgym.models.model_file`)."""
+        return {"vmm": actuator_document(self.params, self.actuators) | {"current": self.current}}
+
+
+def actuator_document(params: VMMParams | MMGParams, actuators: Mapping[str, float]) -> dict:
+    """The model's fields with the identified actuator causes written as the simulated ship
+    takes them: ``rudder_offset`` (the zero error on the rudder order), a steering gear of
+    time constant ``T_d`` (``rudder_time_constant``, ``direct_rudder`` false) and the delay
+    ``input_delay_s`` of :class:`~shipgym.models.ShipModel`."""
+    from dataclasses import asdict
+
+    doc = params.to_dict() if isinstance(params, VMMParams) else asdict(params)
+    if "delta0" in actuators:
+        doc["rudder_offset"] = actuators["delta0"]
+    if "T_d" in actuators:
+        doc |= {"rudder_time_constant": actuators["T_d"], "direct_rudder": False}
+    if "tau" in actuators:
+        doc["input_delay_s"] = actuators["tau"]
+    return doc
 
 
 def _terms_of(term_set: str | Sequence[str], effects: Sequence[str]) -> list[str]:
-    base = list(TERM_SETS[term_set]) if isinstance(term_set, str) else list(term_set)
+    """The terms of the loop's model: a named set without its :data:`ASYMMETRY_TERMS` unless
+    ``asymmetry`` is in, then the effects' own terms; an explicit list of terms as given."""
+    if not isinstance(term_set, str):
+        base = list(term_set)
+    else:
+        full = TERM_SETS[term_set]
+        base = [t for t in full if t not in ASYMMETRY_TERMS]
+        if "asymmetry" in effects:
+            base += [t for t in full if t in ASYMMETRY_TERMS] or list(_EFFECT_TERMS["asymmetry"])
     for e in effects:
-        base += [t for t in _EFFECT_TERMS.get(e, ()) if t not in base]
+        if e != "asymmetry":
+            base += [t for t in _EFFECT_TERMS.get(e, ()) if t not in base]
     return base
 
 
@@ -704,15 +794,22 @@ def fit_vmm(
     rp: _Replay | None = None,
     fit_runs: Sequence[int] | None = None,
     refine_fit: bool = True,
-    start: VMMFit | None = None,
+    actuators: Mapping[str, float] | None = None,
 ) -> VMMFit:
-    """Regression, then (with ``rp``) output-error refinement on the runs ``fit_runs``."""
+    """Regression, then (with ``rp``) output-error refinement on the runs ``fit_runs``; the
+    regression sees the rudder felt under ``actuators`` (:func:`felt_rudder`), which the
+    refinement refines with the coefficients."""
     terms = _terms_of(term_set, effects)
+    act = dict(actuators or {})
     chosen = [runs[i] for i in (fit_runs if fit_runs is not None else range(len(runs)))]
+    if act:
+        gear = _gear_of(template)
+        chosen = [replace(r, delta=felt_rudder(r.t, r.delta, act, gear)) for r in chosen]
     cur = _current_fit(chosen, template, terms) if "current" in effects else (0.0, 0.0)
     reg = regress(chosen, template, terms, current=cur)
     params = template.with_coefficients(reg.coefficients)
-    fit = VMMFit(params, cur, tuple(effects), reg, False, dict(reg.stderr))
+    name = term_set if isinstance(term_set, str) else ""
+    fit = VMMFit(params, cur, tuple(effects), reg, False, dict(reg.stderr), act, name)
     if refine_fit and rp is not None:
         fit = refine(fit, rp, fit_runs if fit_runs is not None else range(len(runs)))
     return fit
@@ -751,14 +848,15 @@ def _fit_windows(
     runs: Sequence[int],
     sigma: np.ndarray,
     start_scale: np.ndarray,
-    model: Callable[[np.ndarray], tuple[VMMParams | MMGParams, tuple[float, float]]],
+    model: Callable[[np.ndarray], tuple[Any, tuple[float, float], Mapping[str, float]]],
     theta0: np.ndarray,
     theta_scale: np.ndarray,
     max_nfev: int,
     theta_bounds: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
     """Weighted least squares of the simulated ``psi, r, u, v`` of the windows of ``runs``
-    over ``theta`` (the parameters ``model`` maps to a ship and a current) and the initial
+    over ``theta`` (the parameters ``model`` maps to a ship, a current and the actuator causes'
+    parameters) and the initial
     sway and yaw rate of every window (with a prior of ``start_scale``).
 
     Returns the solution (``theta``), the start states ``x0``, the costs before and after,
@@ -779,8 +877,8 @@ def _fit_windows(
         return x0
 
     def resid(th: np.ndarray) -> np.ndarray:
-        params, cur = model(th[:n_c])
-        sim = replay(rp, params, cur, starts(th))[mask]
+        params, cur, act = model(th[:n_c])
+        sim = replay(rp, params, cur, starts(th), act)[mask]
         e = _channel_errors(sim, meas) / sigma[:, None]
         e = np.clip(np.where(np.isfinite(e), e, 1e3), -1e3, 1e3).ravel()
         return np.concatenate((e, (th[n_c:].reshape(-1, 2) / start_scale).ravel()))
@@ -817,11 +915,34 @@ def _channel_sigma(rp: _Replay, runs: Sequence[int], fit: VMMFit) -> np.ndarray:
     mask = rp.run_mask(runs)
     meas = rp.measured[mask]
     spread = np.array([meas[:, 2].std(), meas[:, 5].std(), meas[:, 3].std(), meas[:, 4].std()])
-    e = _channel_errors(replay(rp, fit.params, fit.current)[mask], meas)
+    e = _channel_errors(replay(rp, fit.params, fit.current, actuators=fit.actuators)[mask], meas)
     with np.errstate(all="ignore"):
         rms = np.sqrt(np.mean(np.where(np.isfinite(e), e, np.inf) ** 2, axis=1))
     rms = np.where(np.isfinite(rms), rms, spread)
     return np.maximum(np.minimum(rms, spread), 1e-3 * np.maximum(spread, 1e-9))
+
+
+def actuator_bounds(name: str, lengths_s: float) -> tuple[float, float]:
+    """Bounds of the parameter of actuator cause ``name`` (the shared bounds, the time
+    constant and the delay capped at :data:`ACTUATOR_SEARCH_LENGTHS` ship lengths of travel
+    ``lengths_s`` [s] each)."""
+    lo, hi = next(iter(CAUSES[name].bounds.values()))
+    if name != "rudder_offset":
+        hi = min(hi, ACTUATOR_SEARCH_LENGTHS * lengths_s)
+        lo = min(lo, 0.01 * hi)
+    return lo, hi
+
+
+def _actuator_scale(name: str) -> float:
+    return {"rudder_offset": math.radians(0.5), "rudder_lag": 0.5, "input_delay": 0.5}[name]
+
+
+_ACTUATOR_OF = {CAUSES[n].parameters[0]: n for n in ACTUATOR_CAUSES}  # delta0 -> rudder_offset
+
+
+def _travel_s(rp: _Replay, length: float) -> float:
+    """One ship length of travel [s] at the replays' median speed."""
+    return length / max(float(np.median(np.abs(rp.measured[:, 3]))), 1e-3)
 
 
 def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20) -> VMMFit:
@@ -832,32 +953,69 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20
     out), estimating the initial sway and yaw rate of every window with the coefficients: a
     near-unstable ship turns a start error of a few hundredths of a degree per second into
     degrees of heading, which the coefficients would otherwise absorb. The initial-state
-    corrections carry a prior of :data:`START_PRIOR` (about the measurement noise). Returns
-    ``fit`` itself when the refinement does not lower the cost of the start.
+    corrections carry a prior of :data:`START_PRIOR` (about the measurement noise). The
+    current and the actuator causes' parameters of ``fit`` are refined with the coefficients,
+    within their bounds (:func:`actuator_bounds`). Returns ``fit`` itself when the refinement
+    does not lower the cost of the start.
     """
     free = [k for k in fit.params.coefficients if k not in fit.regression.collinear]
-    extra = ["V_x", "V_y"] if "current" in fit.effects else []
-    theta0 = np.array([fit.params.coefficients[k] for k in free]
-                      + [fit.values[k] for k in extra])  # fmt: skip
+    extra = ["V_n", "V_e"] if "current" in fit.effects else []
+    acts = list(fit.actuators)
+    theta0 = np.array(
+        [fit.params.coefficients[k] for k in free]
+        + [fit.values[k] for k in extra]
+        + [fit.actuators[k] for k in acts]
+    )
     scale = np.array(
         [max(abs(fit.params.coefficients[k]), fit.stderr.get(k, 0.0) or 0.0, 1e-6)
-         for k in free] + [0.01] * len(extra)
+         for k in free] + [0.01] * len(extra) + [_actuator_scale(_ACTUATOR_OF[k]) for k in acts]
     )  # fmt: skip
+    bounds = [(-math.inf, math.inf)] * len(free) + [VMM_EFFECTS["current"].bounds[k]
+                                                   for k in extra]  # fmt: skip
+    travel = _travel_s(rp, fit.params.length)
+    bounds += [actuator_bounds(_ACTUATOR_OF[k], travel) for k in acts]
+    lo, hi = (np.array(b, dtype=np.float64) for b in zip(*bounds, strict=True))
+    theta0 = np.clip(theta0, lo, hi)
+    n_free, n_cur = len(free), len(free) + len(extra)
 
-    def model(th: np.ndarray) -> tuple[VMMParams, tuple[float, float]]:
+    def model(th: np.ndarray) -> tuple[VMMParams, tuple[float, float], dict[str, float]]:
         coeffs = dict(fit.params.coefficients)
-        coeffs.update(zip(free, th[: len(free)], strict=True))
-        vals = dict(zip(extra, th[len(free) :], strict=True))
-        return fit.params.with_coefficients(coeffs), (vals.get("V_x", 0.0), vals.get("V_y", 0.0))
+        coeffs.update(zip(free, th[:n_free], strict=True))
+        vals = dict(zip(extra, th[n_free:n_cur], strict=True))
+        act = {k: float(v) for k, v in zip(acts, th[n_cur:], strict=True)}
+        cur = (vals.get("V_n", 0.0), vals.get("V_e", 0.0))
+        return fit.params.with_coefficients(coeffs), cur, act
 
-    theta, _, before, after, _ = _fit_windows(
+    theta, _, before, after, se = _fit_windows(
         rp, fit_runs, _channel_sigma(rp, fit_runs, fit), _start_scale(rp, fit.params.length),
-        model, theta0, scale, max_nfev,
+        model, theta0, scale, max_nfev, (lo, hi),
     )  # fmt: skip
     if not after < before:
         return fit
-    params, cur = model(theta)
-    return replace(fit, params=params, current=cur, refined=True)
+    params, cur, act = model(theta)
+    stderr = dict(fit.stderr) | {k: float(v) for k, v in zip(acts, se[n_cur:], strict=True)}
+    return replace(fit, params=params, current=cur, refined=True, actuators=act, stderr=stderr)
+
+
+def search_actuator(rp: _Replay, runs: Sequence[int], fit: Any, name: str) -> dict[str, float]:
+    """``fit``'s actuator parameters with that of cause ``name`` added at the value that
+    minimises the weighted replay error of ``runs`` with the rest of the model fixed (a
+    bounded Brent search, each value one replay): the start of the joint refinement."""
+    key = CAUSES[name].parameters[0]
+    lo, hi = actuator_bounds(name, _travel_s(rp, fit.params.length))
+    mask = rp.run_mask(runs)
+    meas = rp.measured[mask]
+    sigma = _channel_sigma(rp, runs, fit)
+
+    def cost(value: float) -> float:
+        act = fit.actuators | {key: value}
+        e = _channel_errors(replay(rp, fit.params, fit.current, actuators=act)[mask], meas)
+        e = np.where(np.isfinite(e), e / sigma[:, None], 1e3)
+        return float(np.sum(np.minimum(e * e, 1e6)))
+
+    sol = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-3 * (hi - lo), "maxiter": 30})  # fmt: skip
+    return fit.actuators | {key: float(sol.x)}
 
 
 def predict(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray:
@@ -866,9 +1024,9 @@ def predict(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray:
     data estimates its initial condition), the measured starts elsewhere."""
     _, x0, _, _, _ = _fit_windows(
         rp, runs, _channel_sigma(rp, runs, fit), _start_scale(rp, fit.params.length),
-        lambda _th: (fit.params, fit.current), np.zeros(0), np.zeros(0), 20,
+        lambda _th: (fit.params, fit.current, fit.actuators), np.zeros(0), np.zeros(0), 20,
     )  # fmt: skip
-    return replay(rp, fit.params, fit.current, x0)
+    return replay(rp, fit.params, fit.current, x0, fit.actuators)
 
 
 # --------------------------------------------------------------------------------------------
@@ -884,6 +1042,7 @@ class _Context:
     held: list[int]
     template: VMMParams
     window_s: float | None
+    term_set: str
 
 
 def _equation_error(fit: VMMFit) -> float:
@@ -946,11 +1105,11 @@ class VMMFamily(ModelFamily):
         self.refine = refine
 
     def candidates(self, current: Candidate) -> list[str]:
-        """The catalogue less what the term set holds already: a set with ``Y_u``, ``N_u``
-        has its constant side force and moment (``u' = u / U`` is close to 1)."""
-        terms = set(TERM_SETS[self.term_set])
-        skip = {"asymmetry"} if terms & {"Y_u", "Y_0", "N_u", "N_0"} else set()
-        skip |= {e for e, t in _EFFECT_TERMS.items() if set(t) <= terms}
+        """The catalogue less the effects whose terms the term set holds already (its
+        straight-running side force and moment, :data:`ASYMMETRY_TERMS`, are the
+        ``asymmetry`` effect's)."""
+        terms = set(TERM_SETS[current.fitted.term_set or self.term_set])
+        skip = {e for e, t in _EFFECT_TERMS.items() if e != "asymmetry" and set(t) <= terms}
         return [e for e in super().candidates(current) if e not in skip]
 
     def prepare(self, record: Any, holdout: float, window_s: float | None) -> _Context:
@@ -980,7 +1139,7 @@ class VMMFamily(ModelFamily):
         rp = _build_replay(runs, template, window_s)
         shooting = REFINE_WINDOW_LENGTHS * lengths_s
         rp_fit = _build_replay(runs, template, min(shooting, window_s or math.inf))
-        return _Context(runs, rp, rp_fit, train, held, template, window_s)
+        return _Context(runs, rp, rp_fit, train, held, template, window_s, self.term_set)
 
     def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
         """Held-out runs replayed with each window's initial sway and yaw rate estimated
@@ -998,10 +1157,19 @@ class VMMFamily(ModelFamily):
         return Candidate(fit.effects, fit, bic(rss, n, k), err, rms)
 
     def _fit(
-        self, ctx: _Context, effects: Sequence[str], runs: Sequence[int], refine_fit: bool
+        self,
+        ctx: _Context,
+        effects: Sequence[str],
+        runs: Sequence[int],
+        refine_fit: bool,
+        actuators: Mapping[str, float] | None = None,
     ) -> VMMFit:
-        return fit_vmm(ctx.runs, ctx.template, self.term_set, effects, rp=ctx.rp_fit,
-                       fit_runs=runs, refine_fit=refine_fit and self.refine)  # fmt: skip
+        fit = fit_vmm(ctx.runs, ctx.template, ctx.term_set, effects, fit_runs=runs,
+                      refine_fit=False, actuators=actuators)  # fmt: skip
+        return self._refined(ctx, fit, runs) if refine_fit and self.refine else fit
+
+    def _refined(self, ctx: _Context, fit: VMMFit, runs: Sequence[int]) -> VMMFit:
+        return refine(fit, ctx.rp_fit, runs)
 
     def _candidate(
         self, ctx: _Context, effects: Sequence[str], screen: Candidate | None = None
@@ -1012,14 +1180,15 @@ class VMMFamily(ModelFamily):
             screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False))
         if not self.refine:
             return screen
-        cand = self._score(ctx, refine(screen.fitted, ctx.rp_fit, ctx.train))
+        cand = self._score(ctx, self._refined(ctx, screen.fitted, ctx.train))
         cand.extra.update(screen.extra)
         return cand
 
     def _refit_all(self, ctx: _Context, cand: Candidate) -> VMMFit:
         """``cand`` refitted on every run: the regression on every run (its standard errors
         and collinear terms), refined from the training fit's coefficients."""
-        fit = self._fit(ctx, cand.effects, list(range(len(ctx.runs))), False)
+        everything = list(range(len(ctx.runs)))
+        fit = self._fit(ctx, cand.effects, everything, False, cand.fitted.actuators)
         if not self.refine:
             return fit
         start = fit.params.with_coefficients(
@@ -1027,7 +1196,7 @@ class VMMFamily(ModelFamily):
              for k, v in cand.fitted.params.coefficients.items()}
         )  # fmt: skip
         warm = replace(fit, params=start, current=cand.fitted.current)
-        return refine(warm, ctx.rp_fit, list(range(len(ctx.runs))))
+        return self._refined(ctx, warm, everything)
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         cand = self._candidate(ctx, ())
@@ -1039,11 +1208,21 @@ class VMMFamily(ModelFamily):
         """Screened by the regression: a candidate whose terms lower the equation error of the
         training runs by less than :data:`SCREEN_MIN_DROP` is scored as regressed (the engine
         then rejects it); the others are refined by output error and judged by that fit (the
-        refinement costs 20-50 times the regression)."""
+        refinement costs 20-50 times the regression).
+
+        An actuator cause (rudder offset, steering-gear lag, input delay) changes the rudder
+        every term sees: its parameter starts where the replay of the current model fits the
+        training runs best (:func:`search_actuator`), the regression is made again on the
+        rudder so felt, and the refinement estimates the parameter with the coefficients; it
+        is never screened out (the regression's derivatives smooth a rudder's timing away)."""
         if name == "wind" and not all(r.has_wind for r in ctx.runs):
             raise ValueError("the records have no wind channels")
         effects = (*current.effects, name)
-        fit = self._fit(ctx, effects, ctx.train, False)
+        if name in ACTUATOR_CAUSES:
+            act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
+            return self._candidate(ctx, effects, self._score(ctx, self._fit(
+                ctx, effects, ctx.train, False, act)))  # fmt: skip
+        fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
         drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
         if not self.refine or drop < SCREEN_MIN_DROP:
             cand = self._score(ctx, fit)
@@ -1055,12 +1234,17 @@ class VMMFamily(ModelFamily):
 
     def effect_parameters(self, fitted: VMMFit, name: str) -> dict[str, float]:
         vals = fitted.values
-        out = {k: vals.get(k, 0.0) for k in VMM_EFFECTS[name].parameters}
-        if name == "asymmetry" and fitted.params.coefficients.get("N_d"):
-            n_d = fitted.params.coefficients["N_d"]
-            out["rudder_offset_deg"] = -math.degrees(out["N_0"] / n_d)
-        elif name == "current":
-            out["speed"] = math.hypot(out["V_x"], out["V_y"])
+        if name == "asymmetry":
+            out = {k: v for k, v in vals.items() if k in ASYMMETRY_TERMS}
+            if fitted.params.coefficients.get("N_d"):  # N_0 + N_u (u' ~ 1) in straight running
+                n_0 = sum(v for k, v in out.items() if k in ("N_0", "N_u", "N_0u", "N_0uu"))
+                out["rudder_offset_deg"] = -math.degrees(n_0 / fitted.params.coefficients["N_d"])
+            return out
+        out = {k: vals.get(k, 0.0) for k in self.catalogue[name].parameters}
+        if name == "current":
+            out["speed"] = math.hypot(out["V_n"], out["V_e"])
+        elif name == "rudder_offset":
+            out["delta0_deg"] = math.degrees(out["delta0"])
         return out
 
     def finish(
@@ -1173,7 +1357,7 @@ class MMGFit:
     params : MMGParams
         The model with the refined derivatives.
     current : tuple of float
-        The current ``(V_x, V_y)`` [m/s] of the records.
+        The current ``(V_n, V_e)`` [m/s] of the records.
     effects : tuple of str
         Effects in the model.
     factors : dict
@@ -1191,14 +1375,16 @@ class MMGFit:
     regression: RegressionResult = field(
         default_factory=lambda: RegressionResult({}, {}, {}, {}, {}, 0)
     )
+    actuators: dict[str, float] = field(default_factory=dict)
+    term_set: str = ""
 
     @property
     def values(self) -> dict[str, float]:
         """The refined derivatives (non-dimensional) and the effects' own parameters."""
         out = {k: float(getattr(self.params, k)) for k in self.factors}
         if "current" in self.effects:
-            out["V_x"], out["V_y"] = self.current
-        return out
+            out["V_n"], out["V_e"] = self.current
+        return out | self.actuators
 
     @property
     def at_bound(self) -> list[str]:
@@ -1207,23 +1393,28 @@ class MMGFit:
         return [k for k, f in self.factors.items() if f <= lo * 1.001 or f >= hi * 0.999]
 
     def model_file(self) -> dict[str, Any]:
-        """The refined MMG parameters (``{"kvlcc2": {field: value}}``)."""
-        from dataclasses import asdict
-
-        return {"kvlcc2": asdict(self.params) | {"current": self.current}}
+        """The refined MMG parameters (``{"kvlcc2": {field: value}}``) with the actuator
+        causes (:func:`actuator_document`; the MMG model has no rudder zero error, so an
+        identified one is kept for information only, as ``rudder_offset``)."""
+        return {"kvlcc2": actuator_document(self.params, self.actuators)
+                | {"current": self.current}}  # fmt: skip
 
 
 class MMGFamily(VMMFamily):
     """The MMG standard model with the published KVLCC2 coefficients (``kvlcc2``), scaled to
     the records' ship and driven by their rudder and propeller revolutions; the derivatives of
     :data:`MMG_FREE` are refined by output error (multiple shooting as for the VMM) within
-    :data:`MMG_FACTOR_BOUNDS` of the published values, and the effect loop tries a current."""
+    :data:`MMG_FACTOR_BOUNDS` of the published values, and the effect loop tries the shared
+    causes a hull with published coefficients can still miss: a current and the actuator
+    causes (rudder zero error, steering-gear lag, input delay), each parameter refined with the
+    derivatives. The model has no wind load to refine, so ``wind`` is not offered."""
 
     def __init__(self) -> None:  # the runs, replays and scoring of the VMM; no term set
         self.name = "kvlcc2"
+        self.term_set = ""
         self.particulars = None
         self.refine = True
-        self.catalogue = {"current": VMM_EFFECTS["current"]}
+        self.catalogue = causes("rudder_offset", "rudder_lag", "input_delay", "current")
 
     def candidates(self, current: Candidate) -> list[str]:
         return [e for e in self.catalogue if e not in current.effects]
@@ -1233,32 +1424,43 @@ class MMGFamily(VMMFamily):
 
     def _fit(
         self, ctx: _Context, effects: Sequence[str], runs: Sequence[int], refine_fit: bool,
-        start: MMGFit | None = None,
+        start: MMGFit | None = None, actuators: Mapping[str, float] | None = None,
     ) -> MMGFit:  # fmt: skip
         published = self._published(ctx)
-        extra = ["V_x", "V_y"] if "current" in effects else []
+        extra = ["V_n", "V_e"] if "current" in effects else []
+        act0 = dict(actuators if actuators is not None else (start.actuators if start else {}))
+        acts = list(act0)
         f0 = [start.factors[k] if start else 1.0 for k in MMG_FREE]
         c0 = list(start.current) if start and "current" in start.effects else [0.0, 0.0]
-        theta0 = np.array(f0 + c0[: len(extra)])
+        theta0 = np.array(f0 + c0[: len(extra)] + [act0[k] for k in acts])
         lo, hi = MMG_FACTOR_BOUNDS
-        bounds = (np.array([lo] * len(MMG_FREE) + [-2.0] * len(extra)),
-                  np.array([hi] * len(MMG_FREE) + [2.0] * len(extra)))  # fmt: skip
+        travel = _travel_s(ctx.rp_fit, published.length)
+        act_bounds = [actuator_bounds(_ACTUATOR_OF[k], travel) for k in acts]
+        bounds = (
+            np.array([lo] * len(MMG_FREE) + [-2.0] * len(extra) + [b[0] for b in act_bounds]),
+            np.array([hi] * len(MMG_FREE) + [2.0] * len(extra) + [b[1] for b in act_bounds]),
+        )
+        n_f, n_c = len(MMG_FREE), len(MMG_FREE) + len(extra)
 
-        def model(th: np.ndarray) -> tuple[MMGParams, tuple[float, float]]:
-            changes = {k: getattr(published, k) * f for k, f in zip(MMG_FREE, th, strict=False)}
-            cur = (float(th[-2]), float(th[-1])) if extra else (0.0, 0.0)
-            return replace(published, **changes), cur
+        def model(th: np.ndarray) -> tuple[MMGParams, tuple[float, float], dict[str, float]]:
+            changes = {k: getattr(published, k) * f
+                       for k, f in zip(MMG_FREE, th[:n_f], strict=True)}  # fmt: skip
+            cur = (float(th[n_f]), float(th[n_f + 1])) if extra else (0.0, 0.0)
+            act = {k: float(v) for k, v in zip(acts, th[n_c:], strict=True)}
+            return replace(published, **changes), cur, act
 
-        seed = MMGFit(published, (0.0, 0.0), tuple(effects), dict.fromkeys(MMG_FREE, 1.0))
+        seed = MMGFit(published, (0.0, 0.0), tuple(effects), dict.fromkeys(MMG_FREE, 1.0),
+                      actuators=act0)  # fmt: skip
         theta, _, _, _, se = _fit_windows(
             ctx.rp_fit, runs, _channel_sigma(ctx.rp_fit, runs, seed),
-            _start_scale(ctx.rp_fit, published.length), model, theta0,
-            np.array([0.1] * len(MMG_FREE) + [0.01] * len(extra)), 20, bounds,
+            _start_scale(ctx.rp_fit, published.length), model, np.clip(theta0, *bounds),
+            np.array([0.1] * n_f + [0.01] * len(extra)
+                     + [_actuator_scale(_ACTUATOR_OF[k]) for k in acts]), 20, bounds,
         )  # fmt: skip
-        params, cur = model(theta)
+        params, cur, act = model(theta)
         return MMGFit(
-            params, cur, tuple(effects), dict(zip(MMG_FREE, map(float, theta), strict=False)),
-            dict(zip([*MMG_FREE, *extra], map(float, se), strict=True)),
+            params, cur, tuple(effects), dict(zip(MMG_FREE, map(float, theta[:n_f]), strict=True)),
+            dict(zip([*MMG_FREE, *extra, *acts], map(float, se), strict=True)), actuators=act,
         )  # fmt: skip
 
     def _candidate(
@@ -1268,7 +1470,12 @@ class MMGFamily(VMMFamily):
         return self._score(ctx, self._fit(ctx, effects, ctx.train, True))
 
     def try_effect(self, ctx: _Context, current: Candidate, name: str) -> Candidate:
-        return self._candidate(ctx, (*current.effects, name))
+        effects = (*current.effects, name)
+        if name in ACTUATOR_CAUSES:  # the parameter starts where the current model fits best
+            act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
+            fit = self._fit(ctx, effects, ctx.train, True, current.fitted, act)
+            return self._score(ctx, fit)
+        return self._score(ctx, self._fit(ctx, effects, ctx.train, True, current.fitted))
 
     def _refit_all(self, ctx: _Context, cand: Candidate) -> MMGFit:
         return self._fit(ctx, cand.effects, list(range(len(ctx.runs))), True, cand.fitted)
