@@ -245,6 +245,10 @@ class VMMParams:
         polynomials.
     direct_rudder : bool
         The input ``delta_c`` is the rudder angle (no steering gear).
+    rudder_offset : float
+        Zero error of the rudder order [rad]: the gear (or, with ``direct_rudder``, the hull)
+        sees ``delta_c + rudder_offset`` (the ``rudder_offset`` cause of
+        :data:`shipgym.sysid.families.base.CAUSES`).
     thrust_from : {"thrust", "rps"}
         What the thrust input of the fitted records was (the measured thrust, or the loading
         ``rho D^4 n |n|``).
@@ -268,6 +272,7 @@ class VMMParams:
     rudder_time_constant: float = 0.05
     include_c_a: bool = True
     direct_rudder: bool = False
+    rudder_offset: float = 0.0
     thrust_from: str = "thrust"
     name: str = "vmm"
     terms: np.ndarray = field(init=False, repr=False)
@@ -286,6 +291,11 @@ class VMMParams:
                 raise ValueError(f"VMMParams.{k} must be a finite number > 0, got {v!r}")
         added = {k: float(dict(self.added).get(k, 0.0)) for k in _ADDED}
         object.__setattr__(self, "added", added)
+        if not (isinstance(self.rudder_offset, int | float) and abs(self.rudder_offset) < 0.5):
+            raise ValueError(
+                f"VMMParams.rudder_offset must be a finite angle in (-0.5, 0.5) rad, got "
+                f"{self.rudder_offset!r}"
+            )
         if self.thrust_from not in ("thrust", "rps"):
             raise ValueError(f"thrust_from must be 'thrust' or 'rps', got {self.thrust_from!r}")
 
@@ -351,7 +361,9 @@ class VMMParams:
             data = data["vmm"]
         if not isinstance(data, dict):
             raise ValueError(f"{str(p)!r} holds no VMM description (a JSON object)")
-        return cls.from_dict({k: v for k, v in data.items() if k != "current"})
+        return cls.from_dict(
+            {k: v for k, v in data.items() if k not in ("current", "input_delay_s")}
+        )
 
     def approach_thrust(self) -> float:
         """Thrust input [N] that holds straight running at the approach speed (from
@@ -380,7 +392,8 @@ _REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
                   "yaw_inertia", "added", "approach_speed")  # fmt: skip
 _OPTIONAL_KEYS = (
     "propeller_diameter", "rho", "max_rudder", "rudder_rate",
-    "rudder_time_constant", "include_c_a", "direct_rudder", "thrust_from", "name",
+    "rudder_time_constant", "include_c_a", "direct_rudder", "rudder_offset", "thrust_from",
+    "name",
 )  # fmt: skip
 
 # packed layout
@@ -392,7 +405,8 @@ P_QX, P_QN, P_L = 10, 11, 12  # rho/2 L^2, rho/2 L^3, L
 P_UMIN = 13
 P_GEAR = 14  # max rudder, rate, 1 / T_delta, direct (1.0) or not
 P_NTERMS = 18
-P_TERMS = 19  # then per term: coefficient, equation, exponents (N_FACTORS)
+P_OFFSET = 19  # rudder zero error
+P_TERMS = 20  # then per term: coefficient, equation, exponents (N_FACTORS)
 TERM_WIDTH = 2 + N_FACTORS
 
 
@@ -422,6 +436,7 @@ def pack_vmm(params: VMMParams) -> np.ndarray:
         q.max_rudder, q.rudder_rate, 1.0 / q.rudder_time_constant, float(q.direct_rudder),
     )  # fmt: skip
     p[P_NTERMS] = n_terms
+    p[P_OFFSET] = q.rudder_offset
     block = p[P_TERMS:].reshape(n_terms, TERM_WIDTH)
     block[:, 0] = list(q.coefficients.values())
     block[:, 1:] = q.terms
@@ -556,12 +571,13 @@ def vmm_row(x, u, p, c, out):
     ur, vr, uc, vc = relative_motion(x, c, out)
     r = x[IR]
     g = P_GEAR
+    order = u[0] + p[P_OFFSET]
     if p[g + 3] != 0.0:
-        delta = u[0]
+        delta = order
         out[IDELTA] = 0.0
     else:
         delta = x[IDELTA]
-        out[IDELTA] = steering_gear(delta, u[0], p[g], p[g + 1], p[g + 2])
+        out[IDELTA] = steering_gear(delta, order, p[g], p[g + 1], p[g + 2])
     fx, fy, fn = vmm_forces(ur, vr, r, delta, u[1], u[2], u[3], p)
     m = p[P_M]
     mxg = p[P_MXG]
