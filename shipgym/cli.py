@@ -1501,6 +1501,17 @@ def _identify_summary(result: Any, source: str) -> str:
     from shipgym.sysid.plots import METRIC_LABELS, format_errors
 
     lines = [f"shipgym identify {source}", f"model: {result.model}"]
+    selection = result.diagnostics.get("term_set_selection")
+    if selection:  # vmm:auto: the term set that predicted the held-out runs best
+        from shipgym.sysid.families.vmm import describe_selection
+
+        lines.append(f"term set: {describe_selection(selection)}")
+    verdict = result.verdict
+    if verdict.identifiable:
+        lines.append("verdict: identifiable")
+    else:
+        lines.append("verdict: NOT IDENTIFIABLE: the record does not determine this model:")
+        lines.extend(f"  - {reason}" for reason in verdict.reasons)
     starts = result.traces.get("window_starts", [0]) if result.traces else [0]
     if "run" in (result.traces or {}):
         how = "each run simulated from its measured initial state"
@@ -1536,7 +1547,14 @@ def _identify_summary(result: Any, source: str) -> str:
                 for k, v in effect.get("parameters", {}).items()
             )
             lines.append(f"  {i}. {effect['name']}: {params}")
-            lines.append(f"     evidence: {_format_evidence(effect.get('evidence', {}))}")
+            evidence = dict(effect.get("evidence", {}))
+            candidate = evidence.pop("candidate_parameters", None)
+            lines.append(f"     evidence: {_format_evidence(evidence)}")
+            if candidate and candidate != effect.get("parameters"):
+                text = ", ".join(
+                    f"{k} = {_format_value(k, v, 4, unit=True)}" for k, v in candidate.items()
+                )
+                lines.append(f"     candidate when accepted (fit on the training part): {text}")
     else:
         lines.append("effects added: none (no candidate was significant on the held-out part)")
     p_before, p_after = result.parameters_before, result.parameters_after
@@ -1657,6 +1675,9 @@ def _run_identify(args: argparse.Namespace) -> int:
     import time
     import warnings
 
+    import numpy as np
+
+    from shipgym.models.vmm import VMMParams, parse_particulars
     from shipgym.sysid import identify
     from shipgym.sysid.fit import SysidWarning
 
@@ -1672,6 +1693,7 @@ def _run_identify(args: argparse.Namespace) -> int:
         print(f"[{time.perf_counter() - t0:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     say = (lambda _msg: None) if args.quiet else progress
+    given = None if args.particulars is None else parse_particulars(args.particulars)
     records, sources = [], []
     for path_text in args.path:
         say(f"loading {path_text} ...")
@@ -1687,6 +1709,17 @@ def _run_identify(args: argparse.Namespace) -> int:
         if args.length is not None:
             record.meta["L"] = args.length
         records.append(record)
+    particulars = None
+    if given is not None:
+        if "approach_speed" not in given:  # the runs' median speed
+            speeds = [r.U if r.U is not None else np.hypot(r.u, r.v) for r in records
+                      if r.U is not None or (r.u is not None and r.v is not None)]  # fmt: skip
+            if speeds:
+                given["approach_speed"] = float(np.median(np.concatenate(speeds)))
+        try:
+            particulars = VMMParams.from_particulars(**given)
+        except ValueError as exc:
+            raise ValueError(f"--particulars: {exc}") from None
     source = sources[0] if len(sources) == 1 else f"{len(sources)} runs:\n  " + "\n  ".join(sources)
     inputs = {Path(p).resolve() for p in args.path}
     for out_path in (json_path, plot_path):
@@ -1707,6 +1740,7 @@ def _run_identify(args: argparse.Namespace) -> int:
                 max_effects=args.max_effects,
                 window_s=args.window,
                 progress=None if args.quiet else progress,
+                particulars=particulars,
             )
         except ValueError as exc:
             raise ValueError(
@@ -1715,6 +1749,13 @@ def _run_identify(args: argparse.Namespace) -> int:
     for msg in dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught):
         note(msg)
     say(f"done in {result.runtime_s:.1f} s")
+    if not result.verdict.identifiable:  # a flagged fit: the warning first, then the report
+        print(
+            f"warning: not identifiable: {'; '.join(result.verdict.reasons)} (the result is "
+            "reported with this verdict; shipgym design refuses it)",
+            file=sys.stderr,
+            flush=True,
+        )
 
     print(_identify_summary(result, source), file=report, flush=True)
     document = result.to_dict()
@@ -1752,7 +1793,15 @@ def _build_identify(sub: Any) -> None:
             "several runs of one ship and hold every few runs out instead. Prints the "
             "simulation errors before and after (heading, yaw rate, and position / speed where "
             "recorded), the effects with their parameters and "
-            "evidence, and the parameters. Progress and data-repair notes go to stderr."
+            "evidence, and the parameters. Progress and data-repair notes go to stderr. "
+            "A record that cannot determine any model is refused with exit code 2 ('not "
+            "identifiable: no excitation: ...': the rudder never moves, or is held for the "
+            "whole record while the ship is already turning, or the heading never changes). "
+            "A fit the record does not determine (a needed parameter without a standard error "
+            "or with one larger than its estimate, a parameter at its bound, K <= 0, a time "
+            "constant far beyond the record, an ill-conditioned regression) is reported with "
+            "a warning first and 'verdict: {\"identifiable\": false, \"reasons\": [...]}' "
+            "in its JSON, which shipgym design refuses."
         ),
     )
     p.add_argument(
@@ -1785,6 +1834,18 @@ def _build_identify(sub: Any) -> None:
         metavar="L",
         help="the ship's length [m], kept in the model file (the envs' option ranges and the "
         "IMO ratios of 'shipgym simulate --model FIT.json' use it); default: the record's",
+    )
+    p.add_argument(
+        "--particulars",
+        default=None,
+        metavar="KEY=VALUE,...",
+        help="the ship of the 3-DOF models (vmm:<term set>) by its main particulars, SI units: "
+        "'length=7.0,breadth=1.27,draught=0.46,displacement=3.27,x_g=0.25,"
+        "propeller_diameter=0.216' (displacement in m^3, or mass= in kg; optional rho= "
+        "(1025), yaw_radius= (0.25 L), block_coefficient= (from the displacement), "
+        "approach_speed= (the runs' median speed)); builds the mass, inertia and Clarke's "
+        "added masses. Default: the records' own (meta lines such as '# L: 7.0', '# draft: "
+        "0.46')",
     )
     p.add_argument(
         "--max-gap",
@@ -1846,7 +1907,11 @@ def _build_identify(sub: Any) -> None:
 def _run_design(args: argparse.Namespace) -> int:
     import json
 
-    from shipgym.benchmark.design import design_heading_autopilot, plot_heading_design
+    from shipgym.benchmark.design import (
+        check_designable,
+        design_heading_autopilot,
+        plot_heading_design,
+    )
     from shipgym.models import NOMOTO_MODEL_NAMES
     from shipgym.models.model_file import load_model
 
@@ -1861,6 +1926,17 @@ def _run_design(args: argparse.Namespace) -> int:
     for out in (json_path, plot_path):
         if out is not None and out.resolve() == path.resolve():
             raise ValueError(f"output {str(out)!r} is the model file; refusing")
+    try:
+        verdict = json.loads(path.read_text(encoding="utf-8")).get("verdict")
+    except (ValueError, AttributeError):
+        verdict = None  # load_model names what is wrong with the file
+    if isinstance(verdict, dict) and verdict.get("identifiable") is False:
+        reasons = "; ".join(str(r) for r in verdict.get("reasons") or []) or "no reason given"
+        raise ValueError(
+            f"{args.model_file!r} is not identifiable: {reasons}; shipgym design needs a model "
+            "the record determines (identify the ship from a record that moves the rudder and "
+            "turns the ship: zigzag, pull-out, random rudder)"
+        )
     model = load_model(path)
     if model.name not in NOMOTO_MODEL_NAMES:
         raise ValueError(
@@ -1868,6 +1944,7 @@ def _run_design(args: argparse.Namespace) -> int:
             f"design takes a Nomoto-family model ({', '.join(NOMOTO_MODEL_NAMES)}: shipgym "
             "identify LOG --model nomoto1 --json FILE)"
         )
+    check_designable(model)
     print(f"designing the heading autopilot for {args.model_file} ...", file=sys.stderr, flush=True)
     design = design_heading_autopilot(model, omega_n=args.bandwidth, zeta=args.damping)
     print(design.summary())
@@ -1899,7 +1976,9 @@ def _build_design(sub: Any) -> None:
             "the ship at the design bandwidth, bandwidth from the steering gear and the ship. "
             "Prints the gains, the open-loop margins with the ship's input delay, the "
             "simulated 10 and 30 deg heading steps and the open-loop 20/20 zigzag. --json "
-            "writes the gains for shipgym evaluate --gains."
+            "writes the gains for shipgym evaluate --gains. A model it cannot design for is "
+            "refused with exit code 2 and the reason: an identification whose verdict is not "
+            "identifiable, or a gain K <= 0 (a positive rudder must give a positive yaw rate)."
         ),
     )
     p.add_argument(

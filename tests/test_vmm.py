@@ -25,7 +25,15 @@ from shipgym.models.vmm import (
 )
 from shipgym.sysid import identify, load
 from shipgym.sysid.data import measured_root
-from shipgym.sysid.families.vmm import prepare_runs, regress, vessel_params
+from shipgym.sysid.families.base import actual_rudder
+from shipgym.sysid.families.vmm import (
+    ASYMMETRY_TERMS,
+    RegressionResult,
+    VMMFit,
+    prepare_runs,
+    regress,
+    vessel_params,
+)
 from shipgym.sysid.generator import generate_vmm_runs, vmm_truth
 
 # one worker runs this file: its module fixtures are built once (pytest-xdist)
@@ -231,6 +239,9 @@ def test_a_clean_ship_gets_no_effect() -> None:
     truth = runs[0].meta["truth"]["coefficients"]
     se = result.diagnostics["final"]["stderr"]
     for name, value in truth.items():
+        if name in ASYMMETRY_TERMS:  # the loop's base leaves the straight-running force out
+            assert value == 0.0 and name not in result.parameters_after
+            continue
         assert abs(result.parameters_after[name] - value) < 3.0 * se[name], name
 
 
@@ -241,6 +252,85 @@ def test_the_rudder_slipstream_is_named() -> None:
     truth = runs[0].meta["truth"]["effect_parameters"]
     for name, value in truth.items():
         assert result.parameters_after[name] == pytest.approx(value, rel=0.15)
+
+
+def _recorded(runs: list, effect: str) -> list:
+    """The runs of a ship whose rudder log is off: a zero error of 1.5 deg (the log reads the
+    actual angle less it) or a log 1 s ahead of the rudder."""
+    if effect == "rudder_offset":
+        return [replace(r, delta=r.delta - math.radians(1.5)) for r in runs]
+    return [replace(r, delta=np.interp(r.time + 1.0, r.time, r.delta)) for r in runs]
+
+
+@pytest.mark.parametrize(("effect", "parameter", "truth", "tol"), [
+    ("rudder_offset", "delta0", math.radians(1.5), math.radians(0.2)),
+    ("input_delay", "tau", 1.0, 0.25),
+])  # fmt: skip
+def test_an_actuator_error_of_the_rudder_log_is_named_and_measured(
+    effect: str, parameter: str, truth: float, tol: float
+) -> None:
+    """A rudder log with a zero error or a lead: the loop names the cause first, measures it
+    and at least halves the held-out heading error. The base model has no straight-running
+    side force (it is the ``asymmetry`` effect), so a zero error is not absorbed by one."""
+    runs = _recorded(generate_vmm_runs(None, n_runs=6, seed=1), effect)
+    result = identify(runs, "vmm:martin_simple", max_effects=1)
+    assert result.effect_names == [effect]
+    assert result.effects[0]["parameters"][parameter] == pytest.approx(truth, abs=tol)
+    held = result.heldout
+    before = held["error_before"]["psi_rms_deg"]
+    assert not before < 2.0 * held["error_after"]["psi_rms_deg"]  # halved (or from a diverging)
+    model = result.ship_model()
+    assert model.params.rudder_offset == pytest.approx(
+        result.parameters_after.get("delta0", 0.0)
+    )
+    assert model.input_delay == pytest.approx(result.parameters_after.get("tau", 0.0))
+
+
+def test_the_rudder_offset_and_gear_of_the_model_are_those_the_identification_applies() -> None:
+    """One definition of the actuator causes: a VMM with a rudder zero error and a steering
+    gear of time constant T_d, simulated from a rudder order, turns its rudder exactly as
+    :func:`actual_rudder` turns the recorded order (the identification's input)."""
+    ship = replace(vmm_truth(), rudder_offset=math.radians(1.2), rudder_time_constant=1.5,
+                   rudder_rate=math.radians(15.8))  # fmt: skip
+    model = make_model("vmm", ship)
+    dt, n = 0.05, 600
+    t = dt * np.arange(n + 1)
+    order = math.radians(20.0) * np.sign(np.sin(2 * math.pi * t / 12.0))
+    x0 = np.zeros(7)
+    x0[3] = ship.approach_speed
+    x0[6] = order[0] + ship.rudder_offset
+    thrust = ship.approach_thrust()
+    res = model.simulate(x0, lambda tk, _x: np.array([order[round(tk / dt)], thrust, 0, 0]), dt, n)
+    from shipgym.models import SteeringGear
+
+    gear = SteeringGear(max_angle=ship.max_rudder, max_rate=ship.rudder_rate)
+    felt = actual_rudder(t, order, rudder_offset=ship.rudder_offset, rudder_lag=1.5, gear=gear,
+                         y0=x0[6])  # fmt: skip
+    np.testing.assert_allclose(res.states[:, 6], felt, atol=math.radians(0.05))
+
+
+def test_asymmetry_holds_the_term_sets_own_straight_running_terms() -> None:
+    from shipgym.sysid.families.vmm import loop_terms
+
+    base = loop_terms("martin_simple", ())
+    assert not set(base) & set(ASYMMETRY_TERMS)
+    assert set(loop_terms("martin_simple", ("asymmetry",))) == set(TERM_SETS["martin_simple"])
+    martin = set(loop_terms("martin", ("asymmetry",))) - set(loop_terms("martin", ()))
+    assert martin == {"Y_u", "N_u"}
+    assert set(loop_terms("linear", ("asymmetry", "current"))) == set(TERM_SETS["linear"])
+
+
+def test_a_fitted_vmm_writes_its_actuator_causes_in_the_model_file(tmp_path: Path) -> None:
+    ship = vmm_truth()
+    fit = VMMFit(ship, (0.1, -0.2), ("rudder_offset", "rudder_lag", "input_delay"),
+                 RegressionResult({}, {}, {}, {}, {}, 0),
+                 actuators={"delta0": 0.02, "T_d": 1.3, "tau": 0.4})  # fmt: skip
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(fit.model_file()))
+    model = make_model(path)
+    assert model.params.rudder_offset == 0.02
+    assert model.params.rudder_time_constant == 1.3 and not model.params.direct_rudder
+    assert model.input_delay == 0.4
 
 
 def test_single_run_families_refuse_several_records(wind_runs) -> None:
