@@ -1041,22 +1041,28 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20
     return replace(fit, params=params, current=cur, refined=True, actuators=act, stderr=stderr)
 
 
+def _replay_cost(rp: _Replay, runs: Sequence[int], fit: Any, weights_of: Any) -> float:
+    """Weighted squared replay error of ``fit`` on ``runs`` from the measured starts (the
+    channels weighted as a refinement of ``weights_of`` weighs them; a diverging sample counts
+    as 1000 of its channel's scale)."""
+    mask = rp.run_mask(runs)
+    sigma = _channel_sigma(rp, runs, weights_of)
+    sim = replay(rp, fit.params, fit.current, actuators=fit.actuators)[mask]
+    e = _channel_errors(sim, rp.measured[mask])
+    with np.errstate(all="ignore"):
+        e = np.clip(np.where(np.isfinite(e), e / sigma[:, None], 1e3), -1e3, 1e3)
+    return float(np.sum(e * e))
+
+
 def search_actuator(rp: _Replay, runs: Sequence[int], fit: Any, name: str) -> dict[str, float]:
     """``fit``'s actuator parameters with that of cause ``name`` added at the value that
     minimises the weighted replay error of ``runs`` with the rest of the model fixed (a
     bounded Brent search, each value one replay): the start of the joint refinement."""
     key = CAUSES[name].parameters[0]
     lo, hi = actuator_bounds(name, _travel_s(rp, fit.params.length))
-    mask = rp.run_mask(runs)
-    meas = rp.measured[mask]
-    sigma = _channel_sigma(rp, runs, fit)
 
     def cost(value: float) -> float:
-        act = fit.actuators | {key: value}
-        e = _channel_errors(replay(rp, fit.params, fit.current, actuators=act)[mask], meas)
-        with np.errstate(all="ignore"):
-            e = np.clip(np.where(np.isfinite(e), e / sigma[:, None], 1e3), -1e3, 1e3)
-        return float(np.sum(e * e))
+        return _replay_cost(rp, runs, replace(fit, actuators=fit.actuators | {key: value}), fit)
 
     sol = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
                           options={"xatol": 1e-3 * (hi - lo), "maxiter": 30})  # fmt: skip
@@ -1266,8 +1272,8 @@ class VMMFamily(ModelFamily):
         effects = (*current.effects, name)
         if name in ACTUATOR_CAUSES:
             act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
-            return self._candidate(ctx, effects, self._score(ctx, self._fit(
-                ctx, effects, ctx.train, False, act)))  # fmt: skip
+            screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False, act))
+            return self._candidate(ctx, effects, screen)
         fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
         drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
         if not self.refine or drop < SCREEN_MIN_DROP:
