@@ -120,6 +120,27 @@ def summarise(rows: list[dict[str, Any]], models: tuple[str, ...]) -> tuple[list
     return out, "\n".join(lines)
 
 
+def not_taken(res: Any) -> str:
+    """The last round's candidates, none of them taken: each one's fitted coefficients (and
+    the bounds they hit) and the held-out heading RMS it gives against the final model's."""
+    final_psi = math.degrees(res.heldout["path"][-1]["heldout_rms"]["psi"])
+    cells = []
+    for name, score in (res.rounds[-1] if res.rounds else {}).items():
+        if "heldout_rms" not in score:
+            continue
+        coef = ", ".join(
+            f"{k.removeprefix('fitted_')} {v:+.3g}" for k, v in score.items()
+            if k.startswith("fitted_")
+        )  # fmt: skip
+        bound = f", at its bound ({score['at_bound']})" if score.get("at_bound") else ""
+        psi = math.degrees(score["heldout_rms"]["psi"])
+        cells.append(f"`{name}` ({coef}{bound}: {psi:.2f} deg)")
+    return (
+        f"Not taken after the last effect (held-out heading RMS {final_psi:.2f} deg; each "
+        "candidate's fitted coefficients and its held-out heading RMS): " + "; ".join(cells) + "."
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--record", default=str(DEFAULT_RECORD), help="the sea-trial CSV")
@@ -206,6 +227,8 @@ def main(argv: list[str] | None = None) -> int:
         f"out; `python scripts/identify_gunnerus.py`, {loop_s:.0f} s): effects named "
         + (", ".join(f"`{e}`" for e in res.effect_names) or "none")
         + ".",
+        "",
+        not_taken(res),
         "",
         "| held-out error | seed 001 | calibrated base | identified |",
         "|---|---|---|---|",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import control
@@ -266,6 +267,45 @@ def test_design_cli_refuses_bad_files_in_one_line(tmp_path: Path, capsys, make, 
     assert err.count("\n") == 1
     if message.startswith("holds a"):
         assert "Nomoto-family" in err and "nomoto1" in err
+
+
+def test_design_refuses_a_gain_of_the_wrong_sign() -> None:
+    """The fit of the decaying turn (K -923 1/s, T 1.7e7 s) designed Kp -8e-5 and a 25 h
+    settling time; a ship with K <= 0 is refused, naming the sign convention."""
+    for K in (-923.0, 0.0):
+        with pytest.raises(ValueError, match=r"cannot design for nomoto1 with K = .* <= 0: under "
+                           r"the Nomoto sign"):  # fmt: skip
+            design_heading_autopilot(make_model("nomoto1", Nomoto1Params(K=K, T=1.7e7)))
+
+
+@pytest.mark.parametrize(
+    ("verdict", "params", "message"),
+    [
+        (None, {"K": -923.0, "T": 1.7e7}, r"cannot design for nomoto1 with K = -923 1/s <= 0"),
+        ({"identifiable": False, "reasons": ["T = 1.7e+07 s is more than 10 times the record"]},
+         {"K": 0.185, "T": 107.3}, r"is not identifiable: T = 1.7e\+07 s is more than 10 times"),
+    ],
+    ids=["negative-gain", "verdict"],
+)
+def test_design_cli_refuses_what_it_cannot_design_for(
+    tmp_path: Path, capsys, verdict: dict | None, params: dict[str, float], message: str
+) -> None:
+    doc: dict = {"nomoto": nomoto_document("nomoto1", params)}
+    if verdict is not None:
+        doc["verdict"] = verdict
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "gains.json"
+    assert main(["design", str(path), "--json", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("shipgym: error: ") and re.search(message, err), err
+    assert err.count("\n") == 1
+    assert not out.exists()
+    # an identifiable verdict designs as before
+    doc["verdict"] = {"identifiable": True, "reasons": []}
+    doc["nomoto"] = nomoto_document("nomoto1", {"K": 0.1, "T": 30.0})
+    path.write_text(json.dumps(doc))
+    assert main(["design", str(path)]) == 0
 
 
 @pytest.mark.parametrize(

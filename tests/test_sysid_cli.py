@@ -34,6 +34,7 @@ JSON_KEYS = {
     "heldout",
     "rounds",
     "runtime_s",
+    "verdict",
 }
 PROGRESS = re.compile(r"^\[\s*\d+\.\d s\] ", flags=re.M)
 
@@ -94,6 +95,7 @@ def test_identify_finds_the_rudder_offset(offset_run: dict[str, Any]) -> None:
         assert {"psi_rms_deg", "r_rms_deg_s", "xy_rms_m"} <= set(err)  # the record has x, y
         assert all(math.isfinite(v) and v >= 0 for v in err.values())
     assert doc["window_s"] is None  # 400 s: one free run
+    assert doc["verdict"] == {"identifiable": True, "reasons": []}
     assert _is_png(offset_run["dir"] / "result.png")
     # nothing but the two outputs (no temporary files left behind)
     assert sorted(p.name for p in offset_run["dir"].iterdir()) == ["result.json", "result.png"]
@@ -101,7 +103,8 @@ def test_identify_finds_the_rudder_offset(offset_run: dict[str, Any]) -> None:
 
 def test_identify_summary_and_progress(offset_run: dict[str, Any]) -> None:
     out, err = offset_run["out"], offset_run["err"]
-    assert "model: nomoto1" in out
+    assert "model: nomoto1\nverdict: identifiable\n" in out
+    assert "warning:" not in err
     assert re.search(r"psi RMS \[deg\]\s+[\d.]+\s+[\d.]+", out), out
     assert re.search(r"1\. rudder_offset: .*delta0 = -?[\d.e-]+ rad \(-?[\d.]+ deg\)", out), out
     assert re.search(r"evidence: BIC change -\d", out), out
@@ -291,9 +294,9 @@ def test_loader_progress_lines_follow_quiet(
 ) -> None:
     """A file above the loader's progress threshold (lowered here) reports its loading on
     stderr unless ``--quiet``."""
-    import shipgym.sysid.data
+    import shipgym.sysid.ingest
 
-    monkeypatch.setattr(shipgym.sysid.data, "PROGRESS_FILE_BYTES", 0)
+    monkeypatch.setattr(shipgym.sysid.ingest, "PROGRESS_FILE_BYTES", 0)
     argv = ["identify", str(records["clean"]), "--max-effects", "0", "--window", "none"]
     code, _, stderr = _run(argv + ["--quiet"] * quiet)
     assert code == 0, stderr

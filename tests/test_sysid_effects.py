@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -55,6 +56,7 @@ def test_catalogue_matches_generator() -> None:
 def test_clean_record_gets_no_effect(maneuver: str, seed: int) -> None:
     res = identify(_record(None, maneuver, seed))
     assert res.effects == []
+    assert res.verdict.identifiable, res.verdict.reasons
     assert res.error_after == res.error_before
     # base fit at the noise level (0.1 deg heading noise, 0.02 deg/s yaw-rate noise)
     assert res.error_before["psi_rms_deg"] < 0.2
@@ -93,6 +95,25 @@ def test_yaw_effect_is_named_first_and_halves_the_error(effect: str) -> None:
     assert ev["heldout_rms_after"]["psi"] < ev["heldout_rms_before"]["psi"]
     # the effect's own parameters, from its catalogue entry
     assert set(res.effects[0]["parameters"]) >= set(NOMOTO_EFFECTS[effect].parameters)
+
+
+def test_a_slow_second_order_mode_does_not_stand_in_for_a_rudder_offset() -> None:
+    """On a rudder-offset record the second-order candidate fits a mode far slower than the
+    record (an integrator: its T2 fixes only K / T2) and matches the offset's BIC to within
+    1 %; its fit is not determined, so it is not significant and the offset is named."""
+    rec = generate_record("rudder_offset", maneuver="zigzag", dt=1.0, duration=DURATION, seed=0)
+    res = identify(rec, max_effects=1)
+    assert res.effect_names == ["rudder_offset"]
+    second = res.rounds[0]["second_order"]
+    offset = res.rounds[0]["rudder_offset"]
+    assert second["delta_J"] < offset["delta_J"] < 0.98 * second["delta_J"]
+    assert not second["significant"]
+    assert re.match(r"T\d = \d+ s is more than 10 times the record", second["not_determined"])
+    assert res.verdict.identifiable
+    # the effect's parameters are the whole-record fit's; the training fit is its candidate
+    ev = res.effects[0]["evidence"]
+    assert res.effects[0]["parameters"]["delta0"] == res.parameters_after["delta0"]
+    assert ev["candidate_parameters"]["delta0"] == pytest.approx(math.radians(-2.0), abs=0.005)
 
 
 def test_effect_parameters_close_to_truth() -> None:

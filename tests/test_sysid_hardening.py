@@ -6,18 +6,30 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import math
+import re
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import pytest
 
-import shipgym.sysid.data as data_module
+import shipgym.sysid.ingest as data_module
 from shipgym.cli import main
 from shipgym.sysid import identify
 from shipgym.sysid.data import Record, SysidDataWarning, load, measured_root
-from shipgym.sysid.fit import fit_equation_error, fit_output_error
+from shipgym.sysid.families import FAMILIES
+from shipgym.sysid.families.base import Verdict, undetermined
+from shipgym.sysid.families.nomoto import CONDITION_LIMIT, fit_problems
+from shipgym.sysid.fit import (
+    FitResult,
+    excitation_problems,
+    fit_equation_error,
+    fit_output_error,
+)
 
 MEASURED = measured_root()
 needs_data = pytest.mark.skipif(
@@ -315,6 +327,230 @@ def test_excited_record_still_fits() -> None:
     fit = fit_output_error(rec.time, rec.delta, rec.psi, rec.r, "nomoto1")
     assert fit.values["K"] == pytest.approx(0.1, rel=0.05)
     assert fit.values["T"] == pytest.approx(30.0, rel=0.05)
+
+
+def decaying_turn(seed: int = 0) -> Record:
+    """A 3.5 m model already in a turn, the rudder held at -35 deg for 200 s while the speed
+    falls from 0.23 to 0.07 m/s: nomoto1 with K' = 2, T' = 1.5 scaled by U / L, so the yaw rate
+    decays with the speed (-4.6 to -1.8 deg/s), not in response to the rudder."""
+    L, dt = 3.5, 0.1
+    t = dt * np.arange(2001)
+    U = 0.07 + 0.16 * (np.exp(-t / 60.0) - math.exp(-t[-1] / 60.0)) / (1 - math.exp(-t[-1] / 60))
+    delta = np.full(t.size, math.radians(-35.0))
+    K, T = 2.0 * U / L, 1.5 * L / U
+    r = np.empty(t.size)
+    r[0] = K[0] * delta[0]
+    for k in range(t.size - 1):
+        r[k + 1] = r[k] + dt * (K[k] * delta[k] - r[k]) / T[k]
+    psi = np.concatenate(([0.0], np.cumsum(0.5 * dt * (r[1:] + r[:-1]))))
+    x = np.concatenate(([0.0], np.cumsum(dt * U[:-1] * np.cos(psi[:-1]))))
+    y = np.concatenate(([0.0], np.cumsum(dt * U[:-1] * np.sin(psi[:-1]))))
+    rng = np.random.default_rng(seed)
+    noise = np.radians([0.05, 0.1, 0.02])[:, None] * rng.standard_normal((3, t.size))
+    return Record(
+        time=t, delta=delta + noise[0], psi=psi + noise[1], r=r + noise[2], x=x, y=y, U=U,
+        meta={"L": L},
+    )  # fmt: skip
+
+
+DECAYING = r"not identifiable: no excitation: the rudder never moves and the ship is already turn"
+
+
+@pytest.mark.parametrize("model", ["nomoto1", "nomoto2", "vmm:martin_simple"])
+def test_decaying_turn_with_the_rudder_held_is_refused_in_every_family(model: str) -> None:
+    rec = decaying_turn()
+    assert math.degrees(rec.r[0]) == pytest.approx(-4.6, abs=0.1)
+    assert (rec.U[0], rec.U[-1]) == pytest.approx((0.23, 0.07))
+    with pytest.raises(ValueError, match=DECAYING + r".*r starts at -4.6 deg/s"):
+        identify(rec, model, max_effects=0)
+
+
+def test_held_rudder_from_a_straight_start_is_a_step_response() -> None:
+    """The same held rudder from a straight course: the yaw rate's change is the response."""
+    t = 0.5 * np.arange(801)
+    r = 0.1 * 0.2 * (1.0 - np.exp(-t / 30.0))
+    psi = np.concatenate(([0.0], np.cumsum(0.5 * (r[1:] + r[:-1]) * np.diff(t))))
+    assert excitation_problems(np.full(t.size, 0.2), psi, r) == []
+    # started 60 s later, the ship already turns at 87 % of its final rate: refused
+    late = slice(120, None)
+    problems = excitation_problems(np.full(t.size, 0.2)[late], psi[late], r[late])
+    assert [kind for kind, _ in problems] == ["rudder"]
+    assert "already turning" in problems[0][1]
+
+
+def _fit(values: dict[str, float], stderr: dict[str, float], condition: float = 10.0) -> FitResult:
+    """A nomoto1 fit result with the given estimates (the reasons read only these)."""
+    return FitResult(
+        "nomoto1", None, values, stderr, np.zeros((0, 0)), tuple(stderr), np.zeros(6),
+        0.0, 0.0, 1.0, "output_error", 100, info={"condition": condition},
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("values", "stderr", "filters", "condition", "expected"),
+    [
+        ({"K": 0.1, "T": 30.0}, {"K": 0.001, "T": 0.5}, None, 10.0, None),
+        ({"K": 0.1, "T": 30.0}, {"K": 0.001}, None, 10.0, r"^T = 30 has no standard error$"),
+        ({"K": 0.1, "T": 30.0}, {"K": 0.2, "T": 0.5}, None, 10.0,
+         r"^K = 0.1 \+- 0.2: the standard error is larger than the estimate$"),
+        ({"K": -923.0, "T": 30.0}, {"K": 1.0, "T": 0.5}, None, 10.0,
+         r"^K = -923 1/s <= 0: with the Nomoto sign .* rudder sign is reversed$"),
+        ({"K": 0.1, "T": 1.7e7}, {"K": 0.01, "T": 1e6}, None, 10.0,
+         r"^T = 1.7e\+07 s is more than 10 times the record \(200 s\): .* neither K nor T$"),
+        ({"K": 0.1, "T1": 30.0, "T2": 5174.0}, {"K": 0.01, "T1": 1.0}, None, 10.0,
+         r"^T2 = 5174 s is more than 10 times the record"),
+        ({"K": 0.1, "T": 1e-6}, {"K": 0.01, "T": 1e-7}, None, 10.0,
+         r"^T = 1e-06 s is at its lower bound"),
+        ({"K": 0.1, "T": 30.0}, {"K": 0.001, "T": 0.5}, {"T_d": 40.0}, 10.0,
+         r"^T_d = 40 s is at a bound of its search \[0.1, 40\] s$"),
+        ({"K": 0.1, "T": 30.0}, {"K": 0.001, "T": 0.5}, {"tau": 0.0}, 10.0,
+         r"^tau = 0 s is at a bound of its search"),
+        ({"K": 0.1, "T": 30.0}, {"K": 0.001, "T": 0.5}, None, 1.6e7,
+         r"^the fit is ill-conditioned \(condition number 1.6e\+07 > 1e\+06\)"),
+    ],
+)
+def test_each_reason_a_nomoto_fit_is_not_determined(
+    values: dict[str, float],
+    stderr: dict[str, float],
+    filters: dict[str, float] | None,
+    condition: float,
+    expected: str | None,
+) -> None:
+    reasons = fit_problems(_fit(values, stderr, condition), 200.0, filters)
+    if expected is None:
+        assert reasons == []
+    else:
+        assert len(reasons) == 1, reasons
+        assert re.search(expected, reasons[0]), reasons[0]
+    assert CONDITION_LIMIT == 1e6
+
+
+def test_undetermined_and_verdict() -> None:
+    values = {"a": 1.0, "b": -0.5, "c": 2.0, "d": math.nan}
+    stderr = {"a": 0.1, "b": 0.6, "c": math.nan, "d": 1.0}
+    assert undetermined(values, stderr, ["a", "b", "c", "d", "missing"]) == [
+        "b = -0.5 +- 0.6: the standard error is larger than the estimate",
+        "c = 2 has no standard error",
+        "d is not finite (nan)",
+    ]
+    assert Verdict.of([]).to_dict() == {"identifiable": True, "reasons": []}
+    assert Verdict.of(["x"]) == Verdict(False, ("x",))
+
+
+def _report(fit: Any, params: dict[str, float], stderr: dict[str, float]) -> dict[str, Any]:
+    return {"final": fit, "parameters_after": params, "diagnostics": {"final": {"stderr": stderr}}}
+
+
+def test_rvg_verdict_names_course_stability_and_effects_not_the_calibration_bounds() -> None:
+    family = FAMILIES["rvg3dof"]
+    values = {"sway_linear_damping": 5e4, "yaw_linear_damping": 8e6, "surge_quadratic_damping":
+              100.0, "alpha_0": 0.01, "V_n": 0.2, "V_e": 0.001}  # fmt: skip
+    stderr = {"sway_linear_damping": 1e3, "yaw_linear_damping": 1e5,
+              "surge_quadratic_damping": 1.0, "alpha_0": 0.001, "V_n": 0.01, "V_e": 0.01}
+    fit = SimpleNamespace(values=values, stderr=stderr, effects=("azimuth_offset", "current"),
+                          at_bound=("surge_quadratic_damping",))  # fmt: skip
+    # a calibrated value at its physical bound is a finding; a current along one axis is fine
+    assert family.verdict(None, _report(fit, values, stderr)) == []
+    fit.stderr = {**stderr, "yaw_linear_damping": 1e7, "alpha_0": 0.02}
+    fit.at_bound = ("sway_linear_damping",)
+    reasons = family.verdict(None, _report(fit, values, fit.stderr))
+    assert reasons == [
+        "yaw_linear_damping = 8e+06 +- 1e+07: the standard error is larger than the estimate",
+        "sway_linear_damping is at a bound of its physical range",
+        "effect azimuth_offset is not determined: alpha_0 = 0.01 +- 0.02: the standard error "
+        "is larger than the estimate",
+    ]
+    nan = dict.fromkeys(stderr, math.nan)
+    assert "the fit has no standard errors" in family.verdict(None, _report(fit, values, nan))[0]
+
+
+def test_vmm_verdict_names_course_stability_and_conditioning() -> None:
+    family = FAMILIES["vmm:martin_simple"]
+    coefficients = {"Y_v": 0.0017, "Y_r": 0.16, "N_v": 0.01, "N_r": -0.04, "Y_vvv": 0.0}
+    stderr = {"Y_v": 0.0093, "Y_r": 0.02, "N_v": 0.0004, "N_r": 0.005, "Y_vvv": math.nan}
+    regression = SimpleNamespace(collinear={"Y_vvv": ["Y_v"]}, condition={"X": 40.0, "Y": 2e4})
+    fit = SimpleNamespace(params=SimpleNamespace(coefficients=coefficients), regression=regression,
+                          stderr=stderr, effects=(), values=coefficients)  # fmt: skip
+    assert family.verdict(None, _report(fit, coefficients, stderr)) == [
+        "Y_v = 0.0017 +- 0.0093: the standard error is larger than the estimate",
+        "the Y regression is ill-conditioned (condition number 2e+04 > 1e+04): its "
+        "coefficients trade for one another",
+    ]
+    fit.stderr = {**stderr, "Y_v": 0.001}
+    regression.condition = {"Y": 500.0}
+    assert family.verdict(None, _report(fit, coefficients, fit.stderr)) == []
+
+
+def test_mmg_verdict_names_a_derivative_at_its_bound() -> None:
+    family = FAMILIES["kvlcc2"]
+    factors = {"r0": 1.0, "y_v": 2.0, "y_r": 1.1, "n_v": 0.9, "n_r": 1.0}
+    stderr = {"r0": 0.01, "y_v": 0.1, "y_r": 1.5, "n_v": 0.1, "n_r": 0.1}
+    fit = SimpleNamespace(factors=factors, stderr=stderr, at_bound=["y_v"])
+    assert family.verdict(None, _report(fit, factors, stderr)) == [
+        "factor on y_r = 1.1 +- 1.5: the standard error is larger than the estimate",
+        "y_v is at a bound of its refinement (factor 2 on the published value, bounds "
+        "(0.5, 2.0))",
+    ]
+
+
+def test_a_ship_far_slower_than_its_record_is_flagged_not_refused() -> None:
+    """K 0.1 1/s and T 3000 s under 200 s of zigzag rudder: the record moves the rudder and
+    turns the ship, but fixes only K / T; the result carries the verdict."""
+    rec = slow_ship()
+    res = identify(rec, "nomoto1", max_effects=0)
+    assert not res.verdict.identifiable
+    assert len(res.verdict.reasons) >= 1
+    assert re.match(r"T = \d+ s is more than 10 times the record \(200 s\)", res.verdict.reasons[0])
+    gain_rate = res.parameters_after["K"] / res.parameters_after["T"]
+    assert gain_rate == pytest.approx(0.1 / 3000, rel=0.2)
+    assert res.to_dict()["verdict"] == {"identifiable": False, "reasons": list(res.verdict.reasons)}
+    # a determined ship gets an identifiable verdict
+    assert identify(_zigzag(), "nomoto1", max_effects=0).verdict == Verdict(True, ())
+
+
+def slow_ship(seed: int = 0) -> Record:
+    """nomoto1 with K 0.1 1/s and T 3000 s: 200 s of a 20 deg rudder switched every 25 s."""
+    dt, K, T = 0.5, 0.1, 3000.0
+    t = dt * np.arange(401)
+    delta = math.radians(20.0) * np.where((t // 25.0) % 2 == 0, 1.0, -1.0)
+    r = np.zeros(t.size)
+    for k in range(t.size - 1):
+        r[k + 1] = r[k] + dt * (K * delta[k] - r[k]) / T
+    psi = np.concatenate(([0.0], np.cumsum(0.5 * dt * (r[1:] + r[:-1]))))
+    rng = np.random.default_rng(seed)
+    return Record(
+        time=t, delta=delta, psi=psi + math.radians(0.05) * rng.standard_normal(t.size),
+        r=r + math.radians(0.01) * rng.standard_normal(t.size),
+    )  # fmt: skip
+
+
+def test_cli_refuses_a_decaying_turn_and_flags_an_undetermined_fit(
+    tmp_path: Path,
+) -> None:
+    """The rudder held at -35 deg while the turning model loses speed: refused with exit 2.
+    A ship far slower than its record: reported, the warning first and the verdict in the
+    JSON, and ``shipgym design`` refuses that file."""
+    turn = decaying_turn().to_csv(tmp_path / "turn.csv")
+    argv = ["identify", str(turn), "--quiet", "--json", str(tmp_path / "t.json")]
+    code, stdout, stderr = _run(argv)
+    assert code == 2 and stdout == ""
+    assert stderr.count("\n") == 1 and "not identifiable: no excitation: the rudder never" in stderr
+    assert not (tmp_path / "t.json").exists()
+
+    slow = slow_ship().to_csv(tmp_path / "slow.csv")
+    fit = tmp_path / "slow.json"
+    code, stdout, stderr = _run(["identify", str(slow), "--quiet", "--max-effects", "0",
+                                 "--json", str(fit)])  # fmt: skip
+    assert code == 0, stderr
+    assert re.match(r"warning: not identifiable: T = \d+ s is more than 10 times", stderr)
+    assert "verdict: NOT IDENTIFIABLE" in stdout and "  - T = " in stdout
+    assert stdout.index("verdict:") < stdout.index("parameters:")
+    doc = json.loads(fit.read_text())
+    assert doc["verdict"]["identifiable"] is False
+    assert doc["verdict"]["reasons"][0].startswith("T = ")
+    code, stdout, stderr = _run(["design", str(fit)])
+    assert code == 2 and stdout == ""
+    assert re.search(r"error: .*slow\.json' is not identifiable: T = \d+ s", stderr), stderr
 
 
 # ---------------------------------------------------------------------------------------------

@@ -28,6 +28,12 @@ Design (seed 004 eq. 7; Fossen 2011, the PID pole placement for the Nomoto model
    third-order reference model at ``w_n``, the gear's limits as the command limits and the
    rudder trim (``n0 / K`` of Norrbin's model, ``b0`` of Bech's) as the offset ``b0``.
 
+A ship the design cannot serve is refused (``ValueError`` naming why): a gain ``K <= 0`` (under
+the Nomoto sign a positive rudder gives a positive yaw rate, so ``K > 0``; a fit with ``K <= 0``
+found no rudder response or the record's rudder sign is reversed, and pole placement on it
+gives gains of the wrong sign), or non-finite parameters. ``shipgym design`` also refuses an
+identification whose verdict is "not identifiable".
+
 Verification:
 
 * Margins of the open loop ``L(s) e^{-s tau}``, ``L = C(s) P(s)`` with
@@ -78,6 +84,7 @@ if TYPE_CHECKING:
 __all__ = [
     "HeadingAutopilotDesign",
     "StepResponse",
+    "check_designable",
     "design_heading_autopilot",
     "plot_heading_design",
 ]
@@ -378,6 +385,32 @@ def _check_model(model: Any) -> None:
         )
 
 
+def check_designable(model: ShipModel) -> None:
+    """Refuse a ship the design cannot serve (module docstring): not a Nomoto-family
+    :class:`ShipModel`, non-finite parameters of its linear yaw response, or ``K <= 0``.
+
+    Raises
+    ------
+    ValueError
+        Naming the model and why.
+    """
+    _check_model(model)
+    name = model.name
+    values = dict(zip(("K", "T1", "T2", "T3", "n1"), nomoto_linear_yaw(model), strict=True))
+    bad = [f"{k} = {v}" for k, v in values.items() if not math.isfinite(v)]
+    if bad:
+        raise ValueError(f"cannot design for {name}: non-finite parameters {', '.join(bad)}")
+    K = values["K"]
+    if K <= 0.0:
+        raise ValueError(
+            f"cannot design for {name} with K = {K:.4g} 1/s <= 0: under the Nomoto sign (a "
+            "positive rudder gives a positive yaw rate) a ship has K > 0; an identification "
+            "with K <= 0 found no rudder response (or the record's rudder sign is reversed), "
+            "and the autopilot designed on it would steer the wrong way; identify the ship "
+            "from a record that moves the rudder (zigzag, pull-out, random rudder)"
+        )
+
+
 def _trim(model: ShipModel) -> float:
     """Rudder angle [rad] that holds the ship straight (its rudder offset)."""
     y = model.params
@@ -601,11 +634,11 @@ def design_heading_autopilot(
     Raises
     ------
     ValueError
-        For a model that is not a Nomoto-family :class:`ShipModel`, bad design values, a
-        ship that cannot hold a straight course within its rudder limit, or steps that are
-        zero or beyond 180 deg.
+        For a model that is not a Nomoto-family :class:`ShipModel`, a gain ``K <= 0`` or
+        non-finite parameters, bad design values, a ship that cannot hold a straight course
+        within its rudder limit, or steps that are zero or beyond 180 deg.
     """
-    _check_model(model)
+    check_designable(model)
     for name, value in (("omega_n", omega_n), ("zeta", zeta)):
         ok = value is None and name == "omega_n"
         ok = ok or (isinstance(value, int | float) and math.isfinite(value) and value > 0)

@@ -16,10 +16,25 @@ Damping (eq. 15): ``D(nu_r) = D_l + D_u |u_r| + D_v |v_r| + D_r |r|``.
 
 Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`` and
 ``alpha' = sat_rate((sat(alpha_c) + alpha_0 - alpha) / tau_alpha)`` (``alpha_0``: an identified
-azimuth offset, 0 in seed 001); each pod at ``(x_t, y_t)`` gives
+azimuth offset, 0 in seed 001). The azimuth order ``alpha_c`` is what a record logs; the pods
+follow it through this servo, whose time constant ``tau_alpha`` the source calls "a pure guess"
+(1 s): the identification's ``rudder_lag`` effect fits it, within
+:data:`AZIMUTH_TIME_CONSTANT_RANGE`, the shared steering-gear cause on the pods. Each pod at ``(x_t, y_t)`` gives
 ``F = T [cos a, sin a, -y_t cos a + x_t sin a]``, so positive azimuth on aft pods turns the ship
 to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
 200 rpm (RVG_PARAMETERS.md).
+
+Thrust asymmetry: at one order the two pods need not deliver the same thrust (a shaft speed off
+its order, since thrust goes as ``n^2`` a 1 % rpm error is 2 % thrust; propellers in different
+condition). The port pod delivers ``(1 + eps) T_1`` and the starboard pod ``(1 - eps) T_2`` of
+their thrust states, in the forces above and in the slipstream of the pod foil force below
+(``eps = 0`` in seed 001). At zero azimuth it adds the yaw moment ``eps (T_1 + T_2) |y_t|``
+(``|y_t|`` = 2.7 m; positive ``eps`` turns the ship to starboard), which grows with thrust as
+an azimuth offset's moment does not; at azimuths ``alpha_1``, ``alpha_2`` it adds the surge
+and side forces ``eps (T_1 [cos, sin] alpha_1 - T_2 [cos, sin] alpha_2)`` and the yaw moment of
+their lever arms (with both pods at one azimuth the forces cancel and the moment is
+``eps (T_1 + T_2) |y_t| cos alpha``), and through the slipstream a difference of the pods'
+normal forces.
 
 Pod foil lift (the "rudder" loads that seed 001 says eq. 19 leaves out). The pods' struts are
 foils; as the MMG rudder (Yasukawa and Yoshimura 2015, eq. 33-42) each makes a force normal to
@@ -113,6 +128,20 @@ POD_SLIPSTREAM_FMU = 0.153
 """``k_s`` [-] of the same fit: the fraction of the far-wake slipstream dynamic pressure the
 strut sees (the thruster_lift effect keeps it fixed and fits ``c_L``)."""
 
+THRUST_ASYMMETRY_MAX = 0.1
+"""Largest ``|eps|`` [-] of the thrust asymmetry: one pod 22 % stronger than the other, a shaft
+speed 10 % off the other's at one order (thrust goes as ``n^2``); far beyond a shaft-speed
+governor's error (about 1 %), which leaves room for propellers in different condition."""
+
+AZIMUTH_TIME_CONSTANT_RANGE = (0.5, 9.0)
+"""Physical range [s] of the pods' azimuth servo time constant ``tau_alpha``. Azimuth drives
+slew at about 10 deg/s (the source's rate limit; class rules ask for at least 1.5 rev/min,
+9 deg/s, and a swing from one side to the other, +-35 deg, at an average of at least 0.4
+rev/min, 2.4 deg/s, at full speed ahead: Lloyd's Register, azimuthing thrusters). A first-order
+servo reaches 95 % of that 70 deg swing in ``3 tau_alpha``, so the rule holds up to 9.2 s: the
+ceiling. The floor is the trials' 0.5 s sample step, below which a record cannot tell a servo
+from none (and the screening replay's 1 s RK4 steps stay stable, ``h / tau_alpha < 2.8``)."""
+
 GRAVITY = 9.81  # [m/s^2]
 _DISPLACEMENT_VOLUME = 574_127.69 / WATER_DENSITY  # [m^3], of the seed-001 mass
 BLOCK_COEFFICIENT = _DISPLACEMENT_VOLUME / (LPP * BREADTH * DRAUGHT)
@@ -201,7 +230,9 @@ class RVGParams:
     pod_x, pod_y : tuple of float
         Pod positions [m] relative to the CG, port pod first (-15.56, -2.7) and (-15.56, 2.7).
     thrust_time_constant, azimuth_time_constant : float
-        Actuator time constants [s] (1 s, "a pure guess" in the source).
+        Actuator time constants [s] (1 s, "a pure guess" in the source). The azimuth one is
+        the pods' servo between the logged order and their angle (the identification's
+        ``rudder_lag`` effect, within ``AZIMUTH_TIME_CONSTANT_RANGE``).
     azimuth_max_rate : float
         [rad/s] (10 deg/s).
     azimuth_max : float
@@ -237,6 +268,11 @@ class RVGParams:
     azimuth_offset : float
         ``alpha_0`` [rad]: the pods' real azimuth is the order plus this (a misaligned pod zero,
         the identification's ``azimuth_offset`` effect; 0 in seed 001), within +-5 deg.
+    thrust_asymmetry : float
+        ``eps`` [-]: the port pod delivers ``(1 + eps)`` and the starboard pod ``(1 - eps)`` of
+        its thrust state (unequal thrust of the two pods at one order, the identification's
+        ``thrust_asymmetry`` effect; 0 in seed 001), within ``+-THRUST_ASYMMETRY_MAX``.
+        Positive ``eps`` turns the ship to starboard.
     name : str
         Name of the parameter set (``"seed001"``; :meth:`sea_trials` gives ``"sea_trials"``).
     """
@@ -276,6 +312,7 @@ class RVGParams:
     crossflow_coefficient: float = 0.0
     wave_resistance: float = 0.0
     azimuth_offset: float = 0.0
+    thrust_asymmetry: float = 0.0
     name: str = "seed001"
 
     def __post_init__(self) -> None:
@@ -326,6 +363,14 @@ class RVGParams:
         for name in ("surge_vv", "surge_vr", "surge_rr"):
             if not math.isfinite(getattr(self, name)):
                 raise ValueError(f"RVGParams.{name} must be finite, got {getattr(self, name)!r}")
+        if not (
+            math.isfinite(self.thrust_asymmetry)
+            and abs(self.thrust_asymmetry) <= THRUST_ASYMMETRY_MAX
+        ):
+            raise ValueError(
+                f"RVGParams.thrust_asymmetry must be within +-{THRUST_ASYMMETRY_MAX:g}, got "
+                f"{self.thrust_asymmetry!r}"
+            )
         if not (math.isfinite(self.azimuth_offset) and abs(self.azimuth_offset) <= math.radians(5)):
             raise ValueError(
                 f"RVGParams.azimuth_offset must be within +-5 deg (+-0.0873 rad), got "
@@ -421,7 +466,8 @@ P_XW = 56  # rho S c_w / (2 g L) of the wave-making resistance
 P_CF_X = 57  # 12 Gauss-Legendre stations x [m] along the hull
 P_CF_W = P_CF_X + _GL_X.size  # and their weights [m]
 P_AOFF = P_CF_W + _GL_X.size  # azimuth offset alpha_0 [rad]
-P_SIZE = P_AOFF + 1
+P_TASYM = P_AOFF + 1  # thrust asymmetry eps [-]
+P_SIZE = P_TASYM + 1
 
 
 def pack_rvg(params: RVGParams) -> np.ndarray:
@@ -462,6 +508,7 @@ def pack_rvg(params: RVGParams) -> np.ndarray:
     p[P_CF_X : P_CF_X + _GL_X.size] = (LPP - CG_FORWARD_OF_AP - half) + half * _GL_X
     p[P_CF_W : P_CF_W + _GL_X.size] = half * _GL_W
     p[P_AOFF] = params.azimuth_offset
+    p[P_TASYM] = params.thrust_asymmetry
     return p
 
 
@@ -542,8 +589,10 @@ def rvg_col(X, U, p, C, K, b):
     # eq. (19)-(20), summed over both pods
     sa1, ca1 = sincos(X[IA1, b])
     sa2, ca2 = sincos(X[IA2, b])
-    th1 = X[IT1, b]
-    th2 = X[IT2, b]
+    # the thrust the pods deliver: port (1 + eps), starboard (1 - eps) of their thrust state
+    eps = param(p, P_TASYM, b)
+    th1 = X[IT1, b] * (1.0 + eps)
+    th2 = X[IT2, b] * (1.0 - eps)
     x1, y1, x2, y2 = (
         param(p, P_POD, b),
         param(p, P_POD + 1, b),
@@ -617,8 +666,8 @@ def rvg_col(X, U, p, C, K, b):
     rate = param(p, P_ARATE, b)
     inv_tau_t = param(p, P_INV_TAU_T, b)
     inv_tau_a = param(p, P_INV_TAU_A, b)
-    dt1 = (min(max(U[0, b], 0.0), tmax) - th1) * inv_tau_t
-    dt2 = (min(max(U[1, b], 0.0), tmax) - th2) * inv_tau_t
+    dt1 = (min(max(U[0, b], 0.0), tmax) - X[IT1, b]) * inv_tau_t
+    dt2 = (min(max(U[1, b], 0.0), tmax) - X[IT2, b]) * inv_tau_t
     aoff = param(p, P_AOFF, b)  # the pods turn to the order plus their offset
     da1 = min(max((min(max(U[2, b], -amax), amax) + aoff - X[IA1, b]) * inv_tau_a, -rate), rate)
     da2 = min(max((min(max(U[3, b], -amax), amax) + aoff - X[IA2, b]) * inv_tau_a, -rate), rate)

@@ -14,7 +14,17 @@ seed 000/002/004, and the R/V Gunnerus 3-DOF model, seed 001), :func:`identify`
    :data:`~shipgym.sysid.families.base.TIE_FRACTION` of the best BIC change the one with the
    fewest parameters wins;
 4. repeats until no candidate is significant or ``max_effects`` are in, then reports the
-   whole-record fits of the base and the final model (:class:`IdentificationResult`).
+   whole-record fits of the base and the final model (:class:`IdentificationResult`), each
+   accepted effect with the parameters of the whole-record fit where the family refits them
+   (the training-part fit it was accepted with is kept as its evidence, a candidate);
+5. judges whether the record determines the final model (the family's
+   :meth:`~shipgym.sysid.families.base.ModelFamily.verdict`: standard errors, bounds, signs,
+   time constants against the record, conditioning) and reports it as
+   :attr:`IdentificationResult.verdict`.
+
+A record without excitation (the rudder never moves, or is held for the whole record while the
+ship is already turning; the heading never changes) is refused before any fit
+(:func:`~shipgym.sysid.fit.excitation_problems`).
 
 The held-out BIC of ``n`` samples and per-channel residual sums of squares ``RSS_ch`` is the
 Gaussian (unknown-variance) ``J = sum_ch n log(RSS_ch / n) + k log(n_ch n)`` with ``k`` the
@@ -24,6 +34,7 @@ the effects' terms) live in its module under :mod:`shipgym.sysid.families`.
 
 from __future__ import annotations
 
+import copy
 import math
 import os
 import time
@@ -33,11 +44,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
-from shipgym.models import ShipModel
+from shipgym.models import ShipModel, VMMParams
 from shipgym.models.model_file import load_model
 from shipgym.sysid.data import Record
-from shipgym.sysid.families.base import Candidate, ModelFamily, get_family, jsonable
+from shipgym.sysid.families.base import Candidate, ModelFamily, Verdict, get_family, jsonable
 from shipgym.sysid.fit import excitation_problems, no_excitation_error
 
 __all__ = ["IdentificationResult", "identify"]
@@ -56,8 +68,11 @@ class IdentificationResult:
         :class:`~shipgym.sysid.fit.FitResult` for the Nomoto family,
         :class:`~shipgym.sysid.families.rvg.RVGFit` for ``rvg3dof``).
     effects : list of dict
-        Accepted effects in order: ``{"name", "parameters", "evidence"}``; ``evidence`` holds the
-        held-out scores before/after and the BIC change.
+        Accepted effects in order: ``{"name", "parameters", "evidence"}``: ``parameters`` of
+        the final whole-record fit where the family refits them; ``evidence`` holds the
+        held-out scores before/after, the BIC change and, under ``candidate_parameters``, the
+        parameters of the training-part fit the effect was accepted with (a candidate, not a
+        result).
     diagnostics : dict
         Residual analysis of the base fit under ``"base"`` and of the final fit under
         ``"final"``.
@@ -86,6 +101,9 @@ class IdentificationResult:
     model_file : dict
         The fitted model as a document the rest of the package reads (``{"vmm": ...}`` for
         the 3-DOF models: :meth:`shipgym.models.VMMParams.load`); empty for the others.
+    verdict : Verdict
+        Whether the record determines the final model, and if not why (the family's
+        :meth:`~shipgym.sysid.families.base.ModelFamily.verdict`).
     """
 
     model: str
@@ -103,6 +121,7 @@ class IdentificationResult:
     rounds: list[dict[str, Any]] = field(default_factory=list)
     runtime_s: float = 0.0
     model_file: dict[str, Any] = field(default_factory=dict)
+    verdict: Verdict = field(default_factory=Verdict)
 
     def ship_model(self) -> ShipModel:
         """The identified ship with its effects (:func:`shipgym.models.model_file.
@@ -127,8 +146,9 @@ class IdentificationResult:
 
         Keys: ``model``, ``parameters_before``, ``error_before``, ``effects`` (``{name,
         parameters, evidence}`` in order), ``parameters``, ``error_after``, ``window_s``,
-        ``heldout``, ``rounds``, ``runtime_s`` and the entries of :attr:`model_file`.
-        Non-finite numbers become ``null``.
+        ``heldout``, ``rounds``, ``runtime_s``, ``verdict`` (``{"identifiable": bool,
+        "reasons": [str, ...]}``) and the entries of :attr:`model_file`. Non-finite numbers
+        become ``null``.
         """
         return jsonable(
             {
@@ -143,6 +163,7 @@ class IdentificationResult:
                 "heldout": self.heldout,
                 "rounds": self.rounds,
                 "runtime_s": self.runtime_s,
+                "verdict": self.verdict.to_dict(),
             }
         )
 
@@ -195,6 +216,7 @@ def _split_segments(
     return out
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # the fits run side by side (pyproject)
 def identify(
     record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
@@ -203,6 +225,7 @@ def identify(
     max_effects: int = 3,
     window_s: float | str | None = "auto",
     progress: Callable[[str], None] | None = None,
+    particulars: VMMParams | None = None,
 ) -> IdentificationResult:
     """Fit a base model, then add catalogue effects while the held-out score improves.
 
@@ -229,6 +252,12 @@ def identify(
         measured state (``"auto"``: the family's default); None: one free run.
     progress : callable, optional
         Called with a one-line message per fit.
+    particulars : VMMParams, optional
+        The ship of the 3-DOF models (``vmm:<term set>``, ``kvlcc2``): mass, inertia,
+        ``x_G``, added masses, e.g. :meth:`VMMParams.from_particulars
+        <shipgym.models.vmm.VMMParams.from_particulars>`; by default the family reads them
+        from the records (:func:`~shipgym.sysid.families.vmm.vessel_params`). Refused for a
+        family that takes none.
 
     Returns
     -------
@@ -244,6 +273,19 @@ def identify(
     """
     t_start = time.perf_counter()
     family = model if isinstance(model, ModelFamily) else get_family(model)
+    if particulars is not None:
+        if not hasattr(family, "particulars"):
+            raise ValueError(
+                f"model {family.name!r} takes no particulars; they go with the 3-DOF models "
+                "vmm:<term set> and kvlcc2"
+            )
+        if not isinstance(particulars, VMMParams):
+            raise ValueError(
+                "particulars must be a shipgym.models.VMMParams (VMMParams.from_particulars"
+                f"(...)), got {type(particulars).__name__}"
+            )
+        family = copy.copy(family)  # the registered family keeps reading the records
+        family.particulars = particulars
     runs = list(record) if isinstance(record, list | tuple) else [record]
     for rec in runs:
         if not isinstance(rec, Record):
@@ -347,10 +389,14 @@ def identify(
         say(f"accepted {best}")
 
     report = family.finish(ctx, base, current, say)
-    final_params = report.pop("effect_parameters", None)
-    if final_params:
-        for e in effects:
-            e["parameters"] = final_params.get(e["name"], e["parameters"])
+    final_params = report.pop("effect_parameters", None) or {}
+    for e in effects:
+        if e["name"] in final_params:  # the training-part fit is a candidate, kept as evidence
+            e["evidence"]["candidate_parameters"] = e["parameters"]
+            e["parameters"] = final_params[e["name"]]
+    verdict = Verdict.of(family.verdict(ctx, report))
+    if not verdict.identifiable:
+        say("not identifiable: " + "; ".join(verdict.reasons))
     report["heldout"]["path"] = path
     return IdentificationResult(
         model=model_name,
@@ -358,5 +404,6 @@ def identify(
         window_s=window,
         rounds=rounds,
         runtime_s=time.perf_counter() - t_start,
+        verdict=verdict,
         **report,
     )

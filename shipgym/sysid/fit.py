@@ -42,11 +42,13 @@ variance per channel). Standard errors are ``s^2 (J^T J)^-1`` at the optimum; th
 white measurement noise and are optimistic when the residual is dominated by model error.
 
 **Excitation.** Both fits (and :func:`shipgym.sysid.engine.identify`, for every model family)
-refuse a record whose rudder never moves (stays at zero, or is held in a steady turn) or whose
-heading never changes (:func:`check_excitation`: spread between the 1st and 99th percentiles above
+refuse a record whose rudder never moves (stays at zero, or is held for the whole record while
+the ship is already turning: a steady or decaying turn) or whose heading never changes
+(:func:`check_excitation`: spread between the 1st and 99th percentiles above
 :data:`RUDDER_EXCITATION` / :data:`HEADING_EXCITATION` and above 6 times the noise estimated
-from second differences) with ``ValueError("not identifiable: no excitation: ...")``: without
-input or response the gain and time constant are not identifiable and the optimiser returns
+from second differences; a held rudder only with a straight start,
+:data:`STRAIGHT_START_FRACTION`) with ``ValueError("not identifiable: no excitation: ...")``:
+without input or response the gain and time constant are not identifiable and the optimiser returns
 meaningless values (T of 1e9 s, K of 1e-40 1/s).
 
 **Rudder replay through the shared kernels.** The simulation runs
@@ -96,10 +98,13 @@ __all__ = [
     "FIT_MODELS",
     "HEADING_EXCITATION",
     "RUDDER_EXCITATION",
+    "STRAIGHT_START_FRACTION",
+    "TIME_CONSTANT_FLOOR",
     "YAW_RATE_EXCITATION",
     "FitResult",
     "SysidWarning",
     "check_excitation",
+    "condition_number",
     "excitation_problems",
     "fit_equation_error",
     "fit_output_error",
@@ -162,6 +167,12 @@ a turning ship; below it the yaw dynamics are not identifiable (no response)."""
 YAW_RATE_EXCITATION: float = math.radians(0.05)
 """Smallest yaw-rate spread [rad/s] that counts as a response when no heading is given."""
 
+STRAIGHT_START_FRACTION: float = 0.2
+"""A rudder held for a whole record identifies the yaw model only as the step response of a
+ship that starts on a straight course: its initial yaw rate within this fraction of the yaw
+rate's spread of zero. A ship already turning when the record starts (a steady turn, or a turn
+whose yaw rate decays as the ship loses speed) shows no response to the rudder."""
+
 
 def _spread_and_noise(a: np.ndarray) -> tuple[float, float]:
     """Spread (1st to 99th percentile) and white-noise level (from second differences)."""
@@ -179,8 +190,10 @@ def excitation_problems(
     """What is missing for a yaw model to be identifiable from a record (empty: nothing).
 
     The rudder must move (spread above :data:`RUDDER_EXCITATION` and above 6 times its noise;
-    a rudder held away from zero is enough while the yaw rate changes, as in a step response
-    from a straight course, but not in a steady turn) and the ship must turn (heading spread
+    a rudder held away from zero is enough only for a step response from a straight course:
+    the yaw rate changes and starts within :data:`STRAIGHT_START_FRACTION` of its spread of
+    zero, as after a rudder step; not in a steady turn, nor in a turn already under way whose
+    yaw rate changes with the speed) and the ship must turn (heading spread
     above :data:`HEADING_EXCITATION`, or without a heading the yaw-rate spread above
     :data:`YAW_RATE_EXCITATION`, again above 6 times the noise). Without either no fit can
     tell the gain from the time constant: it returns meaningless numbers (T of 1e9 s, K of
@@ -197,7 +210,7 @@ def excitation_problems(
     -------
     list of (str, str)
         One ``(kind, phrase)`` per missing excitation: kind ``"rudder"`` (the rudder never
-        moves, or is held in a steady turn) or ``"turn"`` (the heading, or the yaw rate,
+        moves, or is held in a steady or decaying turn) or ``"turn"`` (the heading, or the yaw rate,
         never changes), and a phrase such as ``"the rudder never moves (...)"``.
     """
     out = []
@@ -216,7 +229,9 @@ def excitation_problems(
             if abs(level) <= limit:  # no input at all
                 out.append(("rudder", f"the rudder never moves ({held})"))
             elif r is not None:  # a held rudder identifies the model only through a transient
-                r_spread, r_noise = _spread_and_noise(np.asarray(r, dtype=np.float64))
+                r_arr = np.asarray(r, dtype=np.float64)
+                r_spread, r_noise = _spread_and_noise(r_arr)
+                r_start = float(np.median(r_arr[: max(5, r_arr.size // 50)]))
                 if not r_spread > max(YAW_RATE_EXCITATION, 6.0 * r_noise):
                     out.append(
                         (
@@ -224,6 +239,19 @@ def excitation_problems(
                             f"the rudder never moves and the yaw rate never changes (a steady "
                             f"turn: {held}; r spans {math.degrees(r_spread):.3g} deg/s, needs "
                             f"more than {math.degrees(YAW_RATE_EXCITATION):.3g} deg/s)",
+                        )
+                    )
+                elif abs(r_start) > STRAIGHT_START_FRACTION * r_spread + 3.0 * r_noise:
+                    out.append(
+                        (
+                            "rudder",
+                            f"the rudder never moves and the ship is already turning when the "
+                            f"record starts (a steady or decaying turn: {held}; r starts at "
+                            f"{math.degrees(r_start):.3g} deg/s and spans "
+                            f"{math.degrees(r_spread):.3g} deg/s: its change is not a response "
+                            f"to the rudder; a held rudder identifies a ship only from a "
+                            f"straight start, within {STRAIGHT_START_FRACTION:g} of that span of "
+                            f"zero)",
                         )
                     )
     checks = []
@@ -748,6 +776,15 @@ def _scaled_inverse(J: np.ndarray) -> np.ndarray:
     return np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale)
 
 
+def condition_number(J: np.ndarray) -> float:
+    """Condition number of ``J`` with unit-norm columns (``inf`` when singular): how nearly
+    the fitted quantities trade for one another, whatever their units."""
+    scale = np.linalg.norm(J, axis=0)
+    scale[scale == 0] = 1.0
+    sv = np.linalg.svd(J / scale, compute_uv=False)
+    return float(sv[0] / sv[-1]) if sv.size and sv[-1] > 0 else math.inf
+
+
 def _delta_method(
     fun: Callable[[np.ndarray], dict[str, float]], theta: np.ndarray, cov: np.ndarray
 ) -> tuple[dict[str, float], np.ndarray, list[str]]:
@@ -1013,7 +1050,9 @@ def _start_values(
     return best.params, best.delta0
 
 
-_LOWER = {"T": 1e-6, "T1": 1e-6, "T2": 1e-6}
+TIME_CONSTANT_FLOOR = 1e-6
+"""Lower bound [s] of the time constants ``T``, ``T1``, ``T2`` in the output-error fit."""
+_LOWER = dict.fromkeys(("T", "T1", "T2"), TIME_CONSTANT_FLOOR)
 
 
 def fit_output_error(
@@ -1083,7 +1122,8 @@ def fit_output_error(
     Returns
     -------
     FitResult
-        ``info`` holds the weights, the optimiser status and the number of evaluations.
+        ``info`` holds the weights, the optimiser status, the number of evaluations and the
+        ``condition`` number of the column-normalised Jacobian (:func:`condition_number`).
 
     Raises
     ------
@@ -1262,6 +1302,7 @@ def fit_output_error(
             "message": str(sol.message),
             "nfev": int(nfev),
             "s2": s2,
+            "condition": condition_number(J),
         },
     )
     _evaluate(result, t, delta, psi, r, speed)

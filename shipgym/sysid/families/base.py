@@ -13,7 +13,9 @@ term, its parameters with bounds, its source). The engine runs one loop over any
    (held-out BIC drop and a minimum relative drop of the held-out error, :data:`BIC_MARGIN`);
 4. ``choose`` picks the best significant candidate (parsimony among near-ties), ``accept``
    makes it the current model, and the loop repeats;
-5. ``finish``: whole-record fits, errors, diagnostics and traces of the base and final models.
+5. ``finish``: whole-record fits, errors, diagnostics and traces of the base and final models;
+6. ``verdict``: the reasons the record does not determine the final model (:class:`Verdict`;
+   shared checks :func:`undetermined` and :meth:`ModelFamily.verdict`, each family its own).
 
 Families register themselves in :data:`FAMILIES` under their model names (the ``--model`` of
 ``shipgym identify``); a new family is one new module and one :func:`register` call.
@@ -54,6 +56,7 @@ __all__ = [
     "Candidate",
     "Effect",
     "ModelFamily",
+    "Verdict",
     "actual_rudder",
     "bic",
     "causes",
@@ -64,6 +67,7 @@ __all__ = [
     "ljung_box",
     "register",
     "shift",
+    "undetermined",
     "window_starts",
     "wrap",
     "xcorr",
@@ -206,6 +210,60 @@ class Candidate:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class Verdict:
+    """Whether an identification determines its model.
+
+    Attributes
+    ----------
+    identifiable : bool
+        True when no reason was found.
+    reasons : tuple of str
+        Why the record does not determine the fitted model, one sentence each (a parameter the
+        model needs without a standard error or with one larger than its estimate, a parameter
+        at its bound, a gain of the wrong sign, a time constant far beyond the record, an
+        ill-conditioned regression: each family's :meth:`ModelFamily.verdict`).
+    """
+
+    identifiable: bool = True
+    reasons: tuple[str, ...] = ()
+
+    @classmethod
+    def of(cls, reasons: Iterable[str]) -> Verdict:
+        """The verdict of ``reasons`` (identifiable when there are none)."""
+        found = tuple(reasons)
+        return cls(not found, found)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``{"identifiable": bool, "reasons": [str, ...]}`` (the JSON of ``shipgym identify``)."""
+        return {"identifiable": self.identifiable, "reasons": list(self.reasons)}
+
+
+def undetermined(
+    values: Mapping[str, float], stderr: Mapping[str, float], names: Iterable[str]
+) -> list[str]:
+    """Reasons the parameters ``names`` of a fit are not determined by their standard errors.
+
+    A parameter of ``values`` among ``names`` without a finite standard error in ``stderr``, or
+    with one larger than the size of its estimate (a 68 % interval that includes zero, or the
+    other sign), is named with its value; ``names`` absent from ``values`` are skipped.
+    """
+    out = []
+    for name in names:
+        if name not in values:
+            continue
+        v, se = values[name], stderr.get(name)
+        if not math.isfinite(v):
+            out.append(f"{name} is not finite ({v})")
+        elif se is None or not math.isfinite(se):
+            out.append(f"{name} = {v:.4g} has no standard error")
+        elif se > abs(v):
+            out.append(
+                f"{name} = {v:.4g} +- {se:.3g}: the standard error is larger than the estimate"
+            )
+    return out
+
+
 class ModelFamily(ABC):
     """A model the identification engine can fit and augment (module docstring).
 
@@ -300,6 +358,25 @@ class ModelFamily(ABC):
         ``error_before``, ``error_after``, ``heldout`` and ``traces`` of
         :class:`shipgym.sysid.engine.IdentificationResult` (effects' parameters updated to the
         whole-record fit under ``effect_parameters``: ``name -> dict``)."""
+
+    def verdict(self, ctx: Any, report: Mapping[str, Any]) -> list[str]:
+        """Reasons the final whole-record fit does not determine the model (empty: it does).
+
+        ``report`` is what :meth:`finish` returned. The default checks what every family
+        reports: each final parameter is finite, and the standard errors under
+        ``report["diagnostics"]["final"]["stderr"]``, where a family gives them, are not all
+        missing. A family states its own checks (the parameters its model needs, their bounds,
+        its regression's conditioning) by overriding this method.
+        """
+        params = report.get("parameters_after") or {}
+        out = [f"{k} is not finite ({v})" for k, v in params.items() if not math.isfinite(v)]
+        final = (report.get("diagnostics") or {}).get("final") or {}
+        stderr = final.get("stderr")
+        if stderr is not None and not any(
+            isinstance(v, int | float) and math.isfinite(v) for v in stderr.values()
+        ):
+            out.append("the fit has no standard errors (its Jacobian is singular)")
+        return out
 
 
 FAMILIES: dict[str, ModelFamily] = {}

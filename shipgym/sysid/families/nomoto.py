@@ -61,6 +61,15 @@ behind a first-order rudder lag (``T_d = T2``), so the two are nearly indistingu
 data; when ``second_order`` wins but its ``|T3| < LAG_EQUIVALENT_T3 * T2`` and ``rudder_lag`` is
 also significant, ``rudder_lag`` (one parameter fewer) is chosen.
 
+Identifiability: a yaw candidate counts only when the training part determines its fit
+(:func:`fit_problems`: ``K > 0`` and ``T`` with standard errors smaller than the estimates, no
+time constant beyond :data:`RECORD_TIME_CONSTANTS` record lengths or at a bound, no
+ill-conditioned Jacobian). On a record with a rudder offset the second-order model fits a mode
+far slower than the record (``T2`` of 5000 s on 420 s), an integrator that matches the offset's
+held-out BIC to within 1 %: not determined, it is not accepted, whatever the tie rule says. The
+same checks on the final whole-record fit are the family's verdict
+(:meth:`NomotoFamily.verdict`).
+
 Parsimony: the candidates whose ``J`` change is within
 :data:`~shipgym.sysid.families.base.TIE_FRACTION` (2 %) of the best one are tied, and the one
 adding the fewest parameters wins (``rudder_offset``, ``rudder_lag``, ``input_delay``: 1;
@@ -120,11 +129,13 @@ from shipgym.sysid.families.base import (
     ljung_box,
     register,
     shift,
+    undetermined,
     window_starts,
     wrap,
     xcorr,
 )
 from shipgym.sysid.fit import (
+    TIME_CONSTANT_FLOOR,
     FitResult,
     SysidWarning,
     fit_equation_error,
@@ -135,12 +146,15 @@ from shipgym.sysid.fit import (
 __all__ = [
     "AUTO_WINDOW_DURATION",
     "AUTO_WINDOW_S",
+    "CONDITION_LIMIT",
     "CURRENT_T_MIN",
     "LAG_EQUIVALENT_T3",
     "MIN_RELATIVE_DROP",
     "NOMOTO_BASES",
     "NOMOTO_EFFECTS",
+    "RECORD_TIME_CONSTANTS",
     "NomotoFamily",
+    "fit_problems",
     "lag_filter",
     "residual_diagnostics",
 ]
@@ -164,6 +178,20 @@ LAG_EQUIVALENT_T3 = 0.5
 
 CURRENT_T_MIN = 5.0
 """Required ``|V| / stderr(V)`` of the drift velocity for ``current``."""
+
+RECORD_TIME_CONSTANTS = 10.0
+"""A time constant (``T``, ``T1``, ``T2``) longer than this many record lengths is not
+determined: within the record such a mode is a pure integrator (``r' = K delta / T``), which
+fixes ``K / T`` but neither ``K`` nor ``T``."""
+
+CONDITION_LIMIT = 1.0e6
+"""Largest condition number of the output-error fit's column-normalised Jacobian
+(:func:`shipgym.sysid.fit.condition_number`) of a determined fit; on generated and measured
+records a determined fit has 5 to 500, the slow second-order mode fitted to 29 s of the SSPA
+zigzag (``T1`` of 7e5 s) 1.6e7."""
+
+_NEEDED = ("K", "T", "T1")
+"""The parameters a Nomoto-family model needs (gain and dominant time constant)."""
 
 AUTO_WINDOW_DURATION = 1000.0
 """Records longer than this [s] are scored in windows of :data:`AUTO_WINDOW_S`."""
@@ -314,11 +342,20 @@ class _Fitted:
 
     def parameters(self) -> dict[str, float]:
         out = {k: float(v) for k, v in self.fit.values.items() if k not in _INITIAL_STATE}
+        return out | self.filters()
+
+    def filters(self) -> dict[str, float]:
+        """The input filters' constants in the model: ``T_d`` [s], ``tau`` [s]."""
+        out = {}
         if self.config.lag:
             out["T_d"] = self.T_d
         if self.config.delay:
             out["tau"] = self.tau
         return out
+
+    def problems(self, duration: float) -> list[str]:
+        """:func:`fit_problems` of this fit on ``duration`` seconds of record."""
+        return fit_problems(self.fit, duration, self.filters())
 
 
 # --------------------------------------------------------------------------------------------
@@ -742,6 +779,74 @@ def _current_test(rec: Record, split: int) -> dict[str, Any] | None:
 
 
 # --------------------------------------------------------------------------------------------
+# identifiability
+
+
+def fit_problems(
+    fit: FitResult, duration: float, filters: Mapping[str, float] | None = None
+) -> list[str]:
+    """Reasons a yaw fit on ``duration`` seconds of record does not determine its model.
+
+    * ``K`` and the dominant time constant (``T``, or ``T1``) without a standard error, or
+      with one larger than the estimate (:func:`~shipgym.sysid.families.base.undetermined`);
+    * ``K <= 0``: under the Nomoto sign (a positive rudder gives a positive yaw rate) every
+      ship has ``K > 0``; a fit with ``K <= 0`` has found no rudder response, or the record's
+      rudder sign is reversed;
+    * a time constant ``T``, ``T1``, ``T2`` longer than :data:`RECORD_TIME_CONSTANTS` record
+      lengths, or at its lower bound;
+    * an input filter's constant (``filters``: ``T_d`` of ``rudder_lag``, ``tau`` of
+      ``input_delay``) at a bound of its search (the bound, not the record, set it);
+    * a condition number of the fit's Jacobian above :data:`CONDITION_LIMIT` (parameters that
+      trade for one another).
+
+    Parameters
+    ----------
+    fit : FitResult
+        An output-error fit (:func:`shipgym.sysid.fit.fit_output_error`).
+    duration : float
+        Length [s] of the record it was fitted to.
+    filters : mapping, optional
+        ``T_d`` and / or ``tau`` [s] of the input filters in the model.
+
+    Returns
+    -------
+    list of str
+        One sentence per reason (empty: determined).
+    """
+    v = fit.values
+    out = undetermined(v, fit.stderr, _NEEDED)
+    K = v.get("K", math.nan)
+    if math.isfinite(K) and K <= 0.0:
+        out.append(
+            f"K = {K:.4g} 1/s <= 0: with the Nomoto sign (a positive rudder gives a positive yaw "
+            "rate) a ship has K > 0; the record shows no rudder response, or its rudder sign is "
+            "reversed"
+        )
+    for name in ("T", "T1", "T2"):
+        T = v.get(name, math.nan)
+        if math.isfinite(T) and T > RECORD_TIME_CONSTANTS * duration:
+            out.append(
+                f"{name} = {T:.4g} s is more than {RECORD_TIME_CONSTANTS:g} times the record "
+                f"({duration:.4g} s): within it the yaw is an integrator r' = K delta / {name}, "
+                f"which fixes K / {name} ({K / T:.3g} 1/s^2) but neither K nor {name}"
+            )
+        elif math.isfinite(T) and T <= 10.0 * TIME_CONSTANT_FLOOR:
+            out.append(f"{name} = {T:.3g} s is at its lower bound ({TIME_CONSTANT_FLOOR:g} s)")
+    bounds = {"T_d": LAG_BOUNDS, "tau": DELAY_BOUNDS}
+    for name, value in (filters or {}).items():
+        lo, hi = bounds[name]
+        if min(value - lo, hi - value) < 0.01 * (hi - lo):
+            out.append(f"{name} = {value:.4g} s is at a bound of its search [{lo:g}, {hi:g}] s")
+    cond = fit.info.get("condition")
+    if cond is not None and cond > CONDITION_LIMIT:
+        out.append(
+            f"the fit is ill-conditioned (condition number {cond:.3g} > {CONDITION_LIMIT:.0e}): "
+            "its parameters trade for one another"
+        )
+    return out
+
+
+# --------------------------------------------------------------------------------------------
 # residual diagnostics
 
 
@@ -851,6 +956,12 @@ class _Context:
     tried: dict[_Config, tuple[_Fitted, dict[str, float]] | Exception] = field(default_factory=dict)
 
     @property
+    def train_duration(self) -> float:
+        """Length [s] of the training part."""
+        t = self.record.time
+        return float(t[self.split - 1] - t[0])
+
+    @property
     def train(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         rec, tr = self.record, slice(0, self.split)
         return rec.time[tr], rec.delta[tr], rec.psi[tr], rec.r[tr]
@@ -904,7 +1015,11 @@ class NomotoFamily(ModelFamily):
         if test is not None:  # the dead reckoning, with the drift once current is in
             after = "after" if fitted.drift is not None else "before"
             rms.update(x=test[f"x_rms_m_{after}"], y=test[f"y_rms_m_{after}"])
-        return Candidate(effects, fitted, sc["J"], sc["psi"], rms, {"J": sc["J"], "k": sc["k"]})
+        extra: dict[str, Any] = {"J": sc["J"], "k": sc["k"]}
+        problems = fitted.problems(ctx.train_duration)
+        if problems:  # a candidate's fit the training part does not determine explains nothing
+            extra["not_determined"] = "; ".join(problems)
+        return Candidate(effects, fitted, sc["J"], sc["psi"], rms, extra)
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         """The base fitted on the training part; also the whole-record fit of the base, the
@@ -975,11 +1090,13 @@ class NomotoFamily(ModelFamily):
 
     def significant(self, cand: Candidate, name: str, delta_j: float, drop: float) -> bool:
         """The engine's rule; ``current`` also needs a drift t statistic above
-        :data:`CURRENT_T_MIN`."""
+        :data:`CURRENT_T_MIN`, a yaw effect a fit the training part determines
+        (:func:`fit_problems`: a second-order mode far slower than the record, for one, is an
+        integrator that can stand in for a rudder offset without being determined)."""
         ok = super().significant(cand, name, delta_j, drop)
         if name == "current":
             ok = ok and cand.extra["evidence_t_stat"] > CURRENT_T_MIN
-        return ok
+        return ok and "not_determined" not in cand.extra
 
     def choose(self, good: Mapping[str, tuple[Candidate, float]]) -> str:
         """The engine's parsimony rule, then ``second_order`` with ``|T3| <
@@ -1057,6 +1174,11 @@ class NomotoFamily(ModelFamily):
             k: float(v) for k, v in ctx.base_full.values.items() if k not in _INITIAL_STATE
         }
         params_after = full.parameters()
+        for key, fit in (("base", ctx.base_full), ("final", full.fit)):
+            diagnostics[key]["stderr"] = {
+                k: v for k, v in fit.stderr.items() if k not in _INITIAL_STATE
+            }
+            diagnostics[key]["condition"] = fit.info.get("condition", math.nan)
         drift = (0.0, 0.0)
         if full.drift is not None:
             drift = full.drift
@@ -1081,13 +1203,17 @@ class NomotoFamily(ModelFamily):
             "heldout": heldout,
             "traces": _traces(rec, ctx.split, starts, sim_before, sim_after),
             "model_file": {"nomoto": _model_document(full, rec)},
-            # the input filters' constants of the whole-record fit
-            "effect_parameters": {
-                e: self.effect_parameters(full, e)
-                for e in final.effects
-                if e in ("rudder_lag", "input_delay")
-            },
+            # every effect's parameters from the whole-record fit (the reported model)
+            "effect_parameters": {e: self.effect_parameters(full, e) for e in final.effects},
         }
+
+    def verdict(self, ctx: _Context, report: Mapping[str, Any]) -> list[str]:
+        """:func:`fit_problems` of the final whole-record fit (``report["final"]``, its input
+        filters' ``T_d``, ``tau`` among the parameters) on the record's length."""
+        t = ctx.record.time
+        params = report["parameters_after"]
+        filters = {k: params[k] for k in ("T_d", "tau") if k in params}
+        return fit_problems(report["final"], float(t[-1] - t[0]), filters)
 
 
 def _model_document(full: _Fitted, rec: Record) -> dict[str, Any]:
