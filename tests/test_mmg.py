@@ -19,7 +19,13 @@ import pytest
 
 from shipgym import maneuvers
 from shipgym.models import MMGParams, RVGParams, make_model
-from shipgym.models.mmg import KVLCC2_SCALE, KVLCC2_SIMMAN_SPEED
+from shipgym.models.mmg import KVLCC2_SCALE, KVLCC2_SIMMAN_SPEED, KVLCC2_WIND_AREAS
+from shipgym.models.wind import (
+    BLENDERMANN_COEFFICIENTS,
+    RHO_AIR,
+    apparent_wind,
+    blendermann_load,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -145,3 +151,106 @@ def test_shipmmg_formulas_reproduce_shipmmg_and_the_paper_differs() -> None:
             assert got[k] == pytest.approx(v, abs=tol), (case["name"], k)
             differs += abs(paper[k] - v) > tol
     assert differs >= 4
+
+
+# --------------------------------------------------------------------------------------------
+# wind (Blendermann 1994, shipgym.models.wind)
+
+_TANKER = BLENDERMANN_COEFFICIENTS["tanker_loaded"]
+
+
+def _load(speed: float, angle_deg: float, p: MMGParams) -> tuple[float, float, float]:
+    return blendermann_load(speed, math.radians(angle_deg), p.wind_frontal_area,
+                            p.wind_lateral_area, p.wind_area_centre, p.length_overall,
+                            *_TANKER)  # fmt: skip
+
+
+def test_blendermann_tanker_coefficients_in_closed_form() -> None:
+    """The loaded tanker's published coefficients (C_Dt 0.70, C_Dl,AF 0.90 from ahead and
+    0.55 from astern, delta 0.40; Blendermann 1994, MSS blendermann94.m) at head, beam, stern
+    and bow-quarter winds, with the wind pushing the ship to leeward and turning a bow wind's
+    bow away from it; odd in the angle for Y and N, even for X."""
+    assert _TANKER == (0.70, 0.90, 0.55, 0.40)
+    p = MMGParams.kvlcc2()
+    q = 0.5 * RHO_AIR * 2.5**2
+    a_f, a_l, s_l, l_oa = (p.wind_frontal_area, p.wind_lateral_area, p.wind_area_centre,
+                           p.length_overall)  # fmt: skip
+    x, y, n = _load(2.5, 0.0, p)
+    assert (x, y, n) == (pytest.approx(-q * a_f * 0.90), 0.0, 0.0)
+    x, y, n = _load(2.5, 180.0, p)
+    assert x == pytest.approx(q * a_f * 0.55) and abs(y) < 1e-12 and abs(n) < 1e-12
+    x, y, n = _load(2.5, 90.0, p)  # from starboard: to port, moment of the area's centroid
+    assert abs(x) < 1e-12
+    assert y == pytest.approx(-q * a_l * 0.70)
+    assert n == pytest.approx(q * a_l * s_l * -0.70)
+    den = 1.0 - 0.5 * 0.40 * (1.0 - 0.90 * a_f / a_l / 0.70)  # sin^2(2 g) = 1 at 45 deg
+    x, y, n = _load(2.5, 45.0, p)
+    c_y = -0.70 * math.sin(math.pi / 4) / den
+    assert x == pytest.approx(-q * a_f * 0.90 * math.cos(math.pi / 4) / den)
+    assert y == pytest.approx(q * a_l * c_y)
+    assert n == pytest.approx(q * a_l * l_oa * (s_l / l_oa + 0.18 * math.pi / 4) * c_y)
+    assert y < 0.0 and n < 0.0  # pushed to port, bow turned to port (away from the wind)
+    xm, ym, nm = _load(2.5, -45.0, p)
+    assert (xm, ym, nm) == (pytest.approx(x), pytest.approx(-y), pytest.approx(-n))
+
+
+def test_apparent_wind_is_the_true_wind_less_the_ship_velocity() -> None:
+    """Head wind of a ship moving in still air; a true wind from the east on a ship heading
+    north at rest comes from starboard; moving, the apparent wind turns towards the bow."""
+    assert apparent_wind(0.0, 1.0, 0.3, 1.2, 0.0) == (pytest.approx(1.2), pytest.approx(0.0))
+    assert apparent_wind(2.0, math.pi / 2, 0.0, 0.0, 0.0) == (
+        pytest.approx(2.0), pytest.approx(math.pi / 2))  # fmt: skip
+    speed, angle = apparent_wind(2.0, math.pi / 2, 0.0, 2.0, 0.0)
+    assert speed == pytest.approx(2.0 * math.sqrt(2.0)) and angle == pytest.approx(math.pi / 4)
+    speed, angle = apparent_wind(1.0, 0.0, math.pi / 2, 0.0, 0.0)  # heading east, wind from N
+    assert angle == pytest.approx(-math.pi / 2)  # from port
+
+
+def test_wind_enters_the_motion_equations_and_no_wind_changes_nothing() -> None:
+    """The wind adds Blendermann's load of the apparent wind to the right of eq. 4 (the same
+    accelerations as the calm-water ones plus the load through the mass matrix); with no wind
+    the ship's wind data change nothing, bit for bit."""
+    calm = MMGParams.kvlcc2()
+    windy = replace(calm, wind_speed=2.5, wind_direction=0.7)
+    n = calm.self_propulsion_rps(KVLCC2_SIMMAN_SPEED)
+    x = np.array([1.0, 2.0, 0.4, 1.1, -0.05, 0.01, math.radians(10.0)])
+    u = [math.radians(10.0), n]
+    d0 = make_model("kvlcc2", calm).deriv(x, u)[0]
+    d1 = make_model("kvlcc2", windy).deriv(x, u)[0]
+    va, g = apparent_wind(2.5, 0.7, x[2], x[3], x[4])
+    xw, yw, nw = _load(va, math.degrees(g), calm)
+    m = calm.mass
+    mx, my, jz = calm.added_masses
+    mass = np.array([[m + my, calm.x_g * m], [calm.x_g * m,
+                     calm.yaw_inertia + calm.x_g**2 * m + jz]])  # fmt: skip
+    assert d1[3] - d0[3] == pytest.approx(xw / (m + mx), rel=1e-9)
+    np.testing.assert_allclose(d1[4:6] - d0[4:6], np.linalg.solve(mass, [yw, nw]), rtol=1e-7)
+    np.testing.assert_array_equal(d1[:3], d0[:3])
+    other = replace(
+        calm, wind_frontal_area=9.0, wind_lateral_area=9.0, wind_area_centre=1.0,
+        length_overall=8.0, wind_direction=2.0, wind_ship_type="tanker_ballast",
+    )  # fmt: skip
+    cmd = np.tile(u, (400, 1))
+    x0 = _straight(make_model("kvlcc2"))
+    np.testing.assert_array_equal(
+        make_model("kvlcc2", other).simulate(x0, cmd, 0.05).states,
+        make_model("kvlcc2", calm).simulate(x0, cmd, 0.05).states,
+    )
+
+
+def test_wind_scales_with_the_ship_and_bad_wind_data_are_refused() -> None:
+    """Froude similarity with wind: the full-scale ship in the Froude-scaled wind turns like
+    the model in ship lengths."""
+    windy = replace(MMGParams.kvlcc2(), wind_speed=2.5, wind_direction=1.0)
+    full = windy.scaled(KVLCC2_SCALE)
+    assert full.wind_speed == pytest.approx(2.5 * math.sqrt(KVLCC2_SCALE))
+    assert full.wind_lateral_area == pytest.approx(KVLCC2_WIND_AREAS[1])
+    model = maneuvers.turning_circle(make_model("kvlcc2", windy), 35.0)
+    ship = maneuvers.turning_circle(make_model("kvlcc2", full), 35.0)
+    assert ship.tactical_diameter / 320.0 == pytest.approx(model.tactical_diameter / 7.0, rel=0.01)
+    with pytest.raises(ValueError, match="wind_speed must be >= 0"):
+        MMGParams(wind_speed=-1.0)
+    with pytest.raises(ValueError, match="wind_ship_type must be one of"):
+        MMGParams(wind_ship_type="yacht")
+    with pytest.raises(ValueError, match="wind_lateral_area must be > 0"):
+        MMGParams(wind_lateral_area=0.0)

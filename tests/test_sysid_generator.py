@@ -9,24 +9,38 @@ R/V Gunnerus base (``base_model="rvg3dof"``): a clean record is an independent
 are the sea trial's (positive azimuth turns to port, ``delta = -azimuth``), and each effect
 changes the motion the way its physics predicts (offset: a port turn for ``alpha_0 > 0``; foil
 lift: faster steady turns; current: a drift of ``V_c t``).
+
+MMG KVLCC2 runs (:func:`generate_mmg_runs`): a clean run is ``make_model("kvlcc2")`` simulated
+directly, and each effect is what it says (the offset shifts the turn like a rudder change, the
+lagged gear's command leads the actual rudder, the delay shifts the motion, the current only
+carries the ship, the recorded apparent wind adds up to the true wind).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from shipgym.models import Nomoto1Params, RVGParams, make_model
+from shipgym.models import MMGParams, Nomoto1Params, RVGParams, make_model
 from shipgym.models import rvg as rvg_model
-from shipgym.sysid.data import Record
+from shipgym.models.mmg import KVLCC2_SIMMAN_SPEED
+from shipgym.sysid.data import Record, wrap_angle
 from shipgym.sysid.fit import fit_output_error, replay
 from shipgym.sysid.generator import (
     BASE_MODELS,
     EFFECT_DEFAULTS,
     EFFECTS,
     EFFECTS_BY_BASE,
+    MMG_DURATION,
+    MMG_EFFECT_RANGES,
+    MMG_EFFECTS,
+    MMG_NOISE,
+    MMG_RUNS,
+    MMG_SPEED_SPREAD,
     NOISE,
     RANDOM_HOLD,
     RANDOM_MAX_RUDDER,
@@ -34,6 +48,7 @@ from shipgym.sysid.generator import (
     RVG_RPM_LEVELS,
     RVG_ZIGZAG_RPM,
     ZIGZAG_ANGLE,
+    generate_mmg_runs,
     generate_record,
 )
 
@@ -522,3 +537,185 @@ def test_rvg_bad_input(kwargs: dict, match: str) -> None:
     effect = kwargs.pop("effect", None)
     with pytest.raises(ValueError, match=match):
         generate_record(effect, **kwargs)
+
+
+# --------------------------------------------------------------------------------------------
+# runs of the MMG KVLCC2 (generate_mmg_runs)
+
+
+def _mmg(effect: str | None = None, n_runs: int = 2, **kwargs) -> list[Record]:
+    return generate_mmg_runs(effect, n_runs=n_runs, noise=kwargs.pop("noise", False), **kwargs)
+
+
+def _direct(rec: Record, command: Callable[[np.ndarray], np.ndarray], **changes) -> object:
+    """``make_model("kvlcc2")`` (with ``changes`` to its parameters) simulated from the record's
+    true initial state at its fine step with the rudder command ``command(t)`` and the
+    record's propeller revolutions, over the record's length."""
+    truth = rec.meta["truth"]
+    h = truth["fine_step"]
+    t = np.arange(round(rec.time[-1] / h)) * h
+    ship = make_model("kvlcc2", replace(MMGParams.kvlcc2(), **changes))
+    u = np.column_stack((command(t), np.full(t.size, truth["rps"])))
+    return ship.simulate(np.array(truth["x0"]), u, h)
+
+
+def _turn(rec: Record, angle: float, offset: float = 0.0) -> Callable[[np.ndarray], np.ndarray]:
+    """The turning run's command: ``offset`` during the approach, then ``angle + offset``."""
+    start = rec.meta["truth"]["approach_s"]
+    return lambda t: np.where(t < start, 0.0, angle) + offset
+
+
+def test_mmg_clean_turn_is_the_kvlcc2_simulated_directly() -> None:
+    """With no effect and no noise, the 35 deg turn is make_model("kvlcc2") simulated with its
+    programme (straight approach, then 35 deg to starboard at constant revolutions); the
+    record's rudder is the gear's actual angle and the propeller runs at the approach speed's
+    self-propulsion point."""
+    rec = _mmg(None, seed=0)[1]
+    assert rec.meta["maneuver"] == "turning" and "starboard" in rec.meta["file"]
+    sim = _direct(rec, _turn(rec, math.radians(35.0)))
+    every = round(rec.dt / rec.meta["truth"]["fine_step"])
+    for k in ("psi", "r", "x", "y", "u", "v", "delta"):
+        np.testing.assert_array_equal(getattr(rec, k), sim[k][::every])
+    speed = rec.meta["truth"]["x0"][3]
+    assert abs(speed / KVLCC2_SIMMAN_SPEED - 1.0) <= MMG_SPEED_SPREAD
+    assert rec.rpm[0] / 60.0 == pytest.approx(MMGParams.kvlcc2().self_propulsion_rps(speed))
+    assert MMG_DURATION[0] <= rec.time[-1] <= MMG_DURATION[1]
+
+
+def test_mmg_rudder_offset_shifts_the_turn_like_a_rudder_change_of_delta_0() -> None:
+    """The actual rudder is the recorded one plus delta_0: the turn is the clean ship's with
+    the rudder at 35 deg + delta_0 (the record still says 35 deg), and its steady turn rate
+    moves from the clean record's by dr/d(delta) delta_0."""
+    clean = _mmg(None, seed=0)[1]
+    rec = _mmg("rudder_offset", seed=0)[1]
+    d0 = rec.meta["truth"]["effect_parameters"]["delta_0"]
+    assert math.radians(1.0) <= abs(d0) <= math.radians(2.0)
+    assert d0 < 0.0  # seed 0: the starboard 35 deg turn stays inside the rudder limit
+    np.testing.assert_allclose(rec.delta[-100:], math.radians(35.0), atol=1e-9)
+    sim = _direct(rec, _turn(rec, math.radians(35.0), d0))
+    np.testing.assert_array_equal(rec.psi, sim["psi"][:: round(rec.dt / sim.time[1])])
+    lo = _direct(clean, _turn(clean, math.radians(33.0)))["r"][-1]
+    slope = (clean.r[-1] - lo) / math.radians(2.0)
+    shift = rec.r[-1] - clean.r[-1]
+    assert abs(shift) > 0.005 * clean.r[-1]
+    assert shift == pytest.approx(slope * d0, rel=0.05)
+
+
+def test_mmg_rudder_lag_records_the_command_that_leads_the_actual_rudder() -> None:
+    """The recorded rudder is the command of a slow gear (T_delta from its range): a clean
+    ship with that gear, ordered the recorded rudder, replays the record, and its actual
+    rudder crosses zero at each zigzag switch a little over T_delta ln 2 after the recorded
+    one (the rate limit slows it at first)."""
+    rec = _mmg("rudder_lag", seed=2, dt=0.05)[0]
+    t_d = rec.meta["truth"]["effect_parameters"]["T_delta"]
+    assert 1.0 <= t_d <= 1.4
+    assert set(np.round(np.degrees(rec.delta), 9)) == {0.0, 10.0, -10.0}  # the orders
+    sim = _direct(rec, lambda t: rec.delta[: t.size], rudder_time_constant=t_d)
+    np.testing.assert_allclose(rec.psi[:-1], sim["psi"][:-1], atol=1e-12)
+    actual = sim["delta"]
+    for k in np.flatnonzero(np.diff(np.sign(rec.delta[:-1])) != 0)[1:]:  # switches after the 1st
+        lag = np.flatnonzero(np.sign(actual[k + 1 :]) == np.sign(rec.delta[k + 1]))[0] + 1
+        assert t_d * math.log(2.0) < lag * rec.dt < 1.5 * t_d
+
+
+def test_mmg_input_delay_records_the_rudder_tau_early() -> None:
+    """In the turn, whose programme does not depend on the heading, the record with an input
+    delay has the clean record's rudder and the clean motion tau later."""
+    clean = _mmg(None, seed=3, dt=0.05)[1]
+    rec = _mmg("input_delay", seed=3, dt=0.05)[1]
+    tau = rec.meta["truth"]["effect_parameters"]["tau"]
+    assert 0.6 - 0.05 <= tau <= 1.0 + 0.05
+    d = round(tau / rec.dt)
+    np.testing.assert_array_equal(rec.delta, clean.delta)
+    for k in ("psi", "r", "u", "v"):
+        np.testing.assert_allclose(getattr(rec, k)[d:], getattr(clean, k)[:-d], atol=1e-9)
+    assert np.max(np.abs(rec.psi - clean.psi)) > math.radians(1.0)
+
+
+def test_mmg_current_only_carries_the_ship() -> None:
+    """A current of 4-8 % of the approach speed: the ship starts steady in the water, so its
+    heading, rudder and motion through the water are the clean record's and its track drifts
+    by the current times the time."""
+    clean = _mmg(None, seed=4)
+    for rc, cur in zip(clean, _mmg("current", seed=4), strict=True):
+        p = cur.meta["truth"]["effect_parameters"]
+        assert 0.04 <= p["speed"] / KVLCC2_SIMMAN_SPEED <= 0.08
+        for k in ("psi", "r", "delta"):
+            np.testing.assert_allclose(getattr(cur, k), getattr(rc, k), atol=1e-9)
+        np.testing.assert_allclose(cur.x - rc.x, p["V_n"] * cur.time, atol=1e-7)
+        np.testing.assert_allclose(cur.y - rc.y, p["V_e"] * cur.time, atol=1e-7)
+        u_c = p["V_n"] * np.cos(cur.psi) + p["V_e"] * np.sin(cur.psi)
+        np.testing.assert_allclose(cur.u - rc.u, u_c, atol=1e-9)
+
+
+def test_mmg_wind_records_the_apparent_wind_of_a_constant_true_wind() -> None:
+    """The recorded apparent wind plus the ship's velocity over ground is the true wind of the
+    truth, constant (2-3 m/s from a seed-drawn direction), and the wind changes the motion."""
+    clean = _mmg(None, seed=5)
+    runs = _mmg("wind", seed=5)
+    p = runs[0].meta["truth"]["effect_parameters"]
+    assert 2.0 <= p["speed"] <= 3.0
+    for rec, rc in zip(runs, clean, strict=True):
+        g, va = rec.wind_angle, rec.wind_speed
+        air_x, air_y = -va * np.cos(g) + rec.u, -va * np.sin(g) + rec.v  # air over ground, body
+        north = air_x * np.cos(rec.psi) - air_y * np.sin(rec.psi)
+        east = air_x * np.sin(rec.psi) + air_y * np.cos(rec.psi)
+        np.testing.assert_allclose(north, -p["speed"] * math.cos(p["direction"]), atol=1e-9)
+        np.testing.assert_allclose(east, -p["speed"] * math.sin(p["direction"]), atol=1e-9)
+        assert rec.rpm[0] == rc.rpm[0]  # the tank's calm-water set-point
+    assert max(np.max(np.abs(a.psi - b.psi)) for a, b in zip(runs, clean, strict=True)) > (
+        math.radians(1.0))  # fmt: skip
+
+
+def test_mmg_noise_on_every_channel_meta_and_reproducible() -> None:
+    """Noise of the stated size on every channel, the same motions without it; the meta
+    states the ship's main particulars as plain keys; a seed gives the same records, another
+    seed other headings, lengths and effect sizes."""
+    noisy = _mmg("wind", seed=1, noise=True)
+    quiet = _mmg("wind", seed=1)
+    pairs = list(zip(noisy, quiet, strict=True))
+    for k, key in (("psi", "psi"), ("r", "r"), ("x", "xy"), ("y", "xy"), ("u", "uv"),
+                   ("v", "uv"), ("delta", "delta"), ("rpm", "rpm"),
+                   ("wind_speed", "wind_speed")):  # fmt: skip
+        e = np.concatenate([getattr(a, k) - getattr(b, k) for a, b in pairs])
+        assert np.std(e) == pytest.approx(MMG_NOISE[key], rel=0.15), k
+    e = np.concatenate([wrap_angle(a.wind_angle - b.wind_angle) for a, b in pairs])
+    assert np.std(e) == pytest.approx(MMG_NOISE["wind_angle"], rel=0.15)
+    meta = noisy[0].meta
+    p = MMGParams.kvlcc2()
+    assert {k: meta[k] for k in ("L", "B", "draft", "displacement_m3", "x_G",
+                                 "propeller_diameter", "rho")} == {
+        "L": p.length, "B": p.breadth, "draft": p.draught, "displacement_m3": p.displacement,
+        "x_G": p.x_g, "propeller_diameter": p.propeller_diameter, "rho": p.rho,
+    }  # fmt: skip
+    assert "particulars" not in meta and meta["scale"] == "model"
+    again = _mmg("wind", seed=1, noise=True)
+    for a, b in zip(noisy, again, strict=True):
+        np.testing.assert_array_equal(a.psi, b.psi)
+        np.testing.assert_array_equal(a.wind_angle, b.wind_angle)
+    other = _mmg("wind", seed=2, noise=True)
+    assert other[0].meta["truth"]["effect_parameters"] != meta["truth"]["effect_parameters"]
+    assert other[0].time[-1] != noisy[0].time[-1]
+    assert [r.meta["file"] for r in generate_mmg_runs(None, noise=False)] == [
+        f"MMG run {k + 1} ({label})" for k, label in enumerate((
+            "zigzag 10/10 starboard", "turning 35 starboard", "zigzag 20/20 starboard",
+            "zigzag 10/10 port", "turning 35 port", "zigzag 20/20 port"))
+    ]  # fmt: skip
+    assert len(MMG_RUNS) == 8 and set(MMG_EFFECTS) == set(MMG_EFFECT_RANGES)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"effect": "asymmetry"}, "unknown effect 'asymmetry'"),
+        ({"n_runs": 0}, r"n_runs must be an integer in \[1, 8\]"),
+        ({"n_runs": 2.0}, "n_runs must be an integer"),
+        ({"dt": 1.0}, r"dt must be in \[0.01, 0.5\] s, got 1.0"),
+        ({"seed": -1}, "seed must be an integer >= 0, got -1"),
+        ({"magnitude": 0.0}, "magnitude must be a finite number > 0, got 0.0"),
+        ({"magnitude": float("nan")}, "magnitude must be a finite number > 0"),
+    ],
+)
+def test_mmg_bad_input(kwargs: dict, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        generate_mmg_runs(**kwargs)

@@ -36,6 +36,12 @@ Rudder (eq. 33-46)::
 propeller-slipstream factor is evaluated as ``u_p sqrt(1 + 8 K_T / (pi J^2)) = sqrt(u_p^2 +
 8 K_T n^2 D^2 / pi)`` with ``u_p = u (1 - w_P)``, which has no singularity at ``J = 0``.
 
+Wind (not in the paper; off by default, ``wind_speed = 0``): a constant true wind adds
+Blendermann's (1994) loads ``X_w``, ``Y_w``, ``N_w`` of the apparent wind
+(:mod:`shipgym.models.wind`: the true wind less the ship's velocity over ground) to the right
+of eq. 4, inside the derivative, so RK4 integrates them with the motion. The ship's wind data
+(``wind_*`` fields, ``length_overall``) default to an estimate for the KVLCC2 (below).
+
 Sign convention: a positive rudder angle turns the ship to starboard (``r > 0``), as the Nomoto
 models (``N_R > 0`` for ``delta > 0`` since ``x_R + a_H x_H < 0``).
 
@@ -52,6 +58,16 @@ per second).
 The KVLCC2 set (:meth:`MMGParams.kvlcc2`) is the 1/45.7 model (L7, 7 m) of Yasukawa and
 Yoshimura (2015, Tables 1-4) at the SIMMAN 2008 conditions (``Fn`` 0.142, ``U_0`` = 1.179
 m/s), as also used by the independent ShipMMG package (``tests/test_mmg_3dof.py``).
+
+The KVLCC2's wind areas are an estimate: the KVLCC2 is defined as a hull form, without a
+superstructure. From its main particulars (SIMMAN 2008: ``L_pp`` 320 m, waterline length
+325.5 m, ``B`` 58 m, depth 30 m, draught 20.8 m, so 9.2 m of freeboard) and an assumed
+accommodation block aft, typical of a VLCC (40 m wide, 25 m long, 20 m above the deck, its
+centre 137.5 m aft of midship), at full scale: ``A_F = 58 x 9.2 + 40 x 20 = 1334 m^2``,
+``A_L = 325.5 x 9.2 + 25 x 20 = 3495 m^2``, the centroid of ``A_L`` ``s_L = -137.5 x 500 /
+A_L = -19.7 m`` (the hull's share centred at midship), and ``L_oa`` taken as the waterline
+length; the 7 m model's are these over ``KVLCC2_SCALE^2`` and ``KVLCC2_SCALE``. Blendermann's
+coefficients are those of a loaded tanker (:data:`shipgym.models.wind.BLENDERMANN_COEFFICIENTS`).
 """
 
 from __future__ import annotations
@@ -63,6 +79,7 @@ import numpy as np
 
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.kinematics import relative_motion, steering_gear
+from shipgym.models.wind import BLENDERMANN_COEFFICIENTS, apparent_wind, blendermann_load
 
 MMG_STATES = ("x", "y", "psi", "u", "v", "r", "delta")
 MMG_INPUTS = ("delta_c", "n")
@@ -76,6 +93,16 @@ KVLCC2_SCALE = 320.0 / 7.0
 """Full-scale (L_pp 320 m) over model-scale (7 m) length of the KVLCC2 L7 model."""
 KVLCC2_SIMMAN_SPEED = 1.179
 """Approach speed [m/s] of the SIMMAN 2008 KVLCC2 L7 free-running tests (``Fn`` 0.142)."""
+KVLCC2_FREEBOARD = 30.0 - 20.8
+"""Freeboard [m] of the full-scale KVLCC2 (depth 30 m, draught 20.8 m)."""
+KVLCC2_WIND_AREAS = (58.0 * KVLCC2_FREEBOARD + 40.0 * 20.0, 325.5 * KVLCC2_FREEBOARD + 25.0 * 20.0)
+"""Estimated frontal and lateral projected wind areas ``A_F``, ``A_L`` [m^2] of the full-scale
+KVLCC2: hull above the waterline plus an assumed accommodation block (module docstring)."""
+KVLCC2_WIND_CENTRE = -137.5 * 25.0 * 20.0 / KVLCC2_WIND_AREAS[1]
+"""Estimated ``s_L`` [m]: centroid of the full-scale KVLCC2's lateral wind area forward of
+midship (module docstring)."""
+KVLCC2_LENGTH_OVERALL = 325.5
+"""``L_oa`` [m] of the wind loads of the full-scale KVLCC2 (its waterline length)."""
 RUDDER_RATE_FULL_SCALE = math.radians(2.32)
 """Rudder rate [rad/s] of the full-scale KVLCC2 (SIMMAN 2008), ``sqrt(320 / 7)`` times faster
 on the model (Froude scaling of time): 15.7 deg/s."""
@@ -143,6 +170,20 @@ class MMGParams:
     speed_at_cg : bool
         ShipMMG's ``U = sqrt(u^2 + (v - x_G r)^2)`` and ``beta = asin(-(v - x_G r) / U)``
         instead of the paper's velocities at midship (``v' = v / U`` in both).
+    wind_speed : float
+        True wind speed [m/s], constant (>= 0; 0, the default: no wind).
+    wind_direction : float
+        Direction the true wind comes from [rad], clockwise from north (the earth x axis).
+    wind_frontal_area, wind_lateral_area : float
+        Frontal and lateral projected wind areas ``A_F``, ``A_L`` [m^2] (module docstring:
+        the KVLCC2's are an estimate).
+    wind_area_centre : float
+        ``s_L`` [m]: centroid of ``A_L`` forward of midship.
+    length_overall : float
+        ``L_oa`` [m] of the wind loads.
+    wind_ship_type : str
+        Blendermann's ship type, a key of
+        :data:`shipgym.models.wind.BLENDERMANN_COEFFICIENTS`.
     name : str
         Name of the set.
     """
@@ -201,12 +242,19 @@ class MMGParams:
     rudder_time_constant: float = 0.05
     wake_formula: str = "paper"
     speed_at_cg: bool = False
+    wind_speed: float = 0.0
+    wind_direction: float = 0.0
+    wind_frontal_area: float = KVLCC2_WIND_AREAS[0] / KVLCC2_SCALE**2
+    wind_lateral_area: float = KVLCC2_WIND_AREAS[1] / KVLCC2_SCALE**2
+    wind_area_centre: float = KVLCC2_WIND_CENTRE / KVLCC2_SCALE
+    length_overall: float = KVLCC2_LENGTH_OVERALL / KVLCC2_SCALE
+    wind_ship_type: str = "tanker_loaded"
     name: str = "kvlcc2"
 
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name in ("name", "wake_formula", "speed_at_cg"):
+            if f.name in ("name", "wake_formula", "speed_at_cg", "wind_ship_type"):
                 continue
             if not (isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)):
                 raise ValueError(f"MMGParams.{f.name} must be a finite number, got {v!r}")
@@ -216,9 +264,17 @@ class MMGParams:
             )
         if not isinstance(self.speed_at_cg, bool):
             raise ValueError(f"MMGParams.speed_at_cg must be a bool, got {self.speed_at_cg!r}")
+        if self.wind_ship_type not in BLENDERMANN_COEFFICIENTS:
+            raise ValueError(
+                f"MMGParams.wind_ship_type must be one of {tuple(BLENDERMANN_COEFFICIENTS)}, "
+                f"got {self.wind_ship_type!r}"
+            )
+        if self.wind_speed < 0.0:
+            raise ValueError(f"MMGParams.wind_speed must be >= 0 m/s, got {self.wind_speed!r}")
         positive = ("rho", "length", "breadth", "draught", "displacement", "gyration",
                     "propeller_diameter", "rudder_area", "rudder_height", "max_rudder",
-                    "rudder_rate", "rudder_time_constant")  # fmt: skip
+                    "rudder_rate", "rudder_time_constant", "wind_frontal_area",
+                    "wind_lateral_area", "length_overall")  # fmt: skip
         for k in positive:
             if getattr(self, k) <= 0.0:
                 raise ValueError(f"MMGParams.{k} must be > 0, got {getattr(self, k)!r}")
@@ -261,7 +317,8 @@ class MMGParams:
     def scaled(self, factor: float) -> MMGParams:
         """The geometrically similar ship ``factor`` times longer (Froude scaling: lengths x
         ``factor``, volumes x ``factor^3``, rudder rate / ``sqrt(factor)``; the non-dimensional
-        derivatives are kept). ``kvlcc2().scaled(KVLCC2_SCALE)`` is the full-scale ship."""
+        derivatives are kept; the wind areas x ``factor^2`` and the wind speed x
+        ``sqrt(factor)``). ``kvlcc2().scaled(KVLCC2_SCALE)`` is the full-scale ship."""
         if not (isinstance(factor, int | float) and math.isfinite(factor) and factor > 0):
             raise ValueError(f"scale factor must be a finite number > 0, got {factor!r}")
         return replace(
@@ -276,6 +333,11 @@ class MMGParams:
             rudder_height=self.rudder_height * factor,
             rudder_rate=self.rudder_rate / math.sqrt(factor),
             rudder_time_constant=self.rudder_time_constant * math.sqrt(factor),
+            wind_speed=self.wind_speed * math.sqrt(factor),
+            wind_frontal_area=self.wind_frontal_area * factor**2,
+            wind_lateral_area=self.wind_lateral_area * factor**2,
+            wind_area_centre=self.wind_area_centre * factor,
+            length_overall=self.length_overall * factor,
         )
 
     def self_propulsion_rps(self, u: float) -> float:
@@ -309,7 +371,9 @@ P_RUD = 39  # rho/2 A_R f_alpha, eta, eps, kappa, gamma-, gamma+, l'_R, 1 - t_R,
 #            x_R + a_H x_H [m]
 P_GEAR = 49  # max rudder, rate, 1 / T_delta
 P_WAKE_SHIPMMG = 52  # 1.0 for ShipMMG's wake formula, else 0.0
-P_SIZE = 53
+P_WIND = 53  # true wind speed, its direction (from), A_F, A_L, s_L, L_oa, C_Dt, C_Dl,AF bow,
+#              C_Dl,AF stern, delta (Blendermann)
+P_SIZE = 63
 
 
 def pack_mmg(params: MMGParams) -> np.ndarray:
@@ -344,12 +408,18 @@ def pack_mmg(params: MMGParams) -> np.ndarray:
     )  # fmt: skip
     p[P_GEAR : P_GEAR + 3] = (q.max_rudder, q.rudder_rate, 1.0 / q.rudder_time_constant)
     p[P_WAKE_SHIPMMG] = 1.0 if q.wake_formula == "shipmmg" else 0.0
+    p[P_WIND : P_WIND + 6] = (
+        q.wind_speed, q.wind_direction, q.wind_frontal_area, q.wind_lateral_area,
+        q.wind_area_centre, q.length_overall,
+    )  # fmt: skip
+    p[P_WIND + 6 : P_WIND + 10] = BLENDERMANN_COEFFICIENTS[q.wind_ship_type]
     return p
 
 
 @row_kernel
 def mmg_row(x, u, p, c, out):
-    """MMG standard model derivative (Yasukawa and Yoshimura 2015 eq. 4-46)."""
+    """MMG standard model derivative (Yasukawa and Yoshimura 2015 eq. 4-46), with the wind
+    loads of :mod:`shipgym.models.wind` when the true wind is not zero."""
     r = x[IR]
     delta = x[IDELTA]
     # velocities relative to the water
@@ -418,6 +488,14 @@ def mmg_row(x, u, p, c, out):
     bx = xh + xr + xp + p[P_MV] * vr * r + xgm * r * r
     by = yh + yr - p[P_MU] * ur * r
     bn = nh + nr - xgm * ur * r
+    w = P_WIND
+    if p[w] != 0.0:  # wind (Blendermann 1994) of the apparent wind over ground
+        va, g = apparent_wind(p[w], p[w + 1], x[IPSI], x[IU], x[IV])
+        xw, yw, nw = blendermann_load(va, g, p[w + 2], p[w + 3], p[w + 4], p[w + 5], p[w + 6],
+                                      p[w + 7], p[w + 8], p[w + 9])  # fmt: skip
+        bx += xw
+        by += yw
+        bn += nw
     out[IU] = bx / p[P_MU] + r * vc
     out[IV] = p[P_INV] * by + p[P_INV + 1] * bn - r * uc
     out[IR] = p[P_INV + 2] * by + p[P_INV + 3] * bn

@@ -133,19 +133,28 @@ with lists for the matrices, ``gear = surge = None``, and the steady relative su
 for tests and benchmarks only: **an identifier or diagnostic must not read it**; nothing else in
 the record (channels or the other meta keys) depends on which effect was applied, apart from the
 effect's influence on the signals.
+
+Several runs of one 3-DOF ship, for the multi-run families (``vmm:<term set>``):
+:func:`generate_vmm_runs` simulates a known VMM (its own polynomials, with ``current``, ``wind``
+or ``rudder_slipstream``); :func:`generate_mmg_runs` simulates the KVLCC2 L7 tank model with the
+MMG standard model (Yasukawa and Yoshimura 2015, :mod:`shipgym.models.mmg`), a structure the VMM
+polynomials do not share, with one of ``rudder_offset``, ``rudder_lag``, ``input_delay``,
+``current`` and ``wind`` (Blendermann's loads, :mod:`shipgym.models.wind`), as short runs as a
+tank gives, noise on every channel and the ship's main particulars as plain meta keys.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
 from scipy.optimize import brentq
 
 from shipgym.models import (
+    MMGParams,
     Nomoto1Params,
     Nomoto2Params,
     NorrbinParams,
@@ -155,8 +164,11 @@ from shipgym.models import (
     SurgeModel,
     make_model,
 )
+from shipgym.models import mmg as _mmg
 from shipgym.models import rvg as _rvg
+from shipgym.models.mmg import KVLCC2_SIMMAN_SPEED
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IU, IX, IY
+from shipgym.models.wind import apparent_wind
 from shipgym.sysid.data import Record, wrap_angle
 
 __all__ = [
@@ -166,11 +178,24 @@ __all__ = [
     "EFFECTS_BY_BASE",
     "EFFECT_DEFAULTS",
     "MANEUVERS",
+    "MMG_APPROACH",
+    "MMG_DURATION",
+    "MMG_EFFECTS",
+    "MMG_EFFECT_RANGES",
+    "MMG_NOISE",
+    "MMG_RUNS",
+    "MMG_SPEED_SPREAD",
     "NOISE",
     "RVG_RPM_HOLD",
     "RVG_RPM_LEVELS",
     "RVG_ZIGZAG_RPM",
+    "VMM_EFFECTS",
+    "VMM_NOISE",
+    "VMM_RUNS",
+    "generate_mmg_runs",
     "generate_record",
+    "generate_vmm_runs",
+    "vmm_truth",
 ]
 
 BASE_MODELS: tuple[str, ...] = ("nomoto1", "rvg3dof")
@@ -748,7 +773,86 @@ def _rvg_record(
 
 
 # --------------------------------------------------------------------------------------------
-# 3-DOF model tests: several runs of one VMM ship
+# 3-DOF model tests: several runs of one ship (shared by the VMM and MMG generators)
+
+
+def _check_runs_arguments(
+    effect: str | None,
+    effects: tuple[str, ...],
+    n_runs: Any,
+    max_runs: int,
+    dt: Any,
+    seed: Any,
+    magnitude: Any,
+) -> None:
+    """``ValueError`` for an argument of :func:`generate_vmm_runs` or :func:`generate_mmg_runs`
+    outside what it accepts (``effects``: the generator's effects; ``max_runs``: the length of
+    its run programme)."""
+    if effect is not None and effect not in effects:
+        raise ValueError(f"unknown effect {effect!r}; expected None or one of {effects}")
+    if not (isinstance(n_runs, int) and not isinstance(n_runs, bool) and 1 <= n_runs <= max_runs):
+        raise ValueError(f"n_runs must be an integer in [1, {max_runs}], got {n_runs!r}")
+    if not (
+        isinstance(dt, int | float) and not isinstance(dt, bool) and math.isfinite(dt)
+        and 0.01 <= dt <= 0.5
+    ):  # fmt: skip
+        raise ValueError(f"dt must be in [0.01, 0.5] s, got {dt!r}")
+    if not (isinstance(seed, int | np.integer) and not isinstance(seed, bool) and seed >= 0):
+        raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
+    if not (
+        isinstance(magnitude, int | float) and not isinstance(magnitude, bool)
+        and math.isfinite(magnitude) and magnitude > 0
+    ):  # fmt: skip
+        raise ValueError(f"magnitude must be a finite number > 0, got {magnitude!r}")
+
+
+def _noisy(rng: np.random.Generator, on: bool, sigma: float, a: np.ndarray) -> np.ndarray:
+    """``a`` plus white Gaussian noise of standard deviation ``sigma`` when ``on``."""
+    return a + rng.normal(0.0, sigma, a.shape[0]) if on else a
+
+
+@dataclass
+class _RudderProgramme:
+    """The rudder command of one run of a 3-DOF run programme (:data:`VMM_RUNS`,
+    :data:`MMG_RUNS`), called with the time and the true heading at every fine step.
+
+    Zero before ``start`` [s]; then a zigzag of ``angle`` [rad] that starts to the side
+    ``sign`` (+1 starboard) and switches each time the heading passes ``+-b`` deg from
+    ``psi0``; a turn of ``angle`` to the side ``sign`` held until ``b`` s before
+    ``duration``, then amidships; or the piecewise-constant ``levels`` (switch times, levels).
+    """
+
+    kind: str
+    angle: float
+    b: float
+    sign: float
+    duration: float
+    psi0: float = 0.0
+    start: float = 0.0
+    levels: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __call__(self, t: float, psi: float) -> float:
+        if t < self.start:
+            return 0.0
+        if self.kind == "zigzag":
+            psi_deg = math.degrees(psi - self.psi0)
+            if self.sign > 0 and psi_deg > self.b:
+                self.sign = -1.0
+            elif self.sign < 0 and psi_deg < -self.b:
+                self.sign = 1.0
+            return self.sign * self.angle
+        if self.kind == "turning":
+            return self.sign * self.angle if t < self.duration - self.b else 0.0
+        assert self.levels is not None
+        times, levels = self.levels
+        return float(levels[np.searchsorted(times, t, side="right") - 1])
+
+
+def _fine_step(dt: float) -> tuple[float, int]:
+    """Integration step ``h <= 0.05 s`` that divides the sampling interval ``dt``, and the
+    number of steps per sample."""
+    h = dt / max(1, math.ceil(dt / 0.05 - 1e-9))
+    return h, round(dt / h)
 
 
 VMM_EFFECTS: tuple[str, ...] = ("current", "wind", "rudder_slipstream")
@@ -833,8 +937,9 @@ def generate_vmm_runs(
         ``current``: a constant current of :data:`VMM_CURRENT_SPEED` x ``magnitude`` toward a
         direction drawn from the seed; ``wind``: a true wind of :data:`VMM_TRUE_WIND_SPEED` from
         a direction drawn from the seed, with the terms of :data:`VMM_EFFECT_TERMS` x
-        ``magnitude`` (the records carry the apparent
-        wind); ``rudder_slipstream``: its terms x ``magnitude``.
+        ``magnitude`` (the records carry the apparent wind,
+        :func:`shipgym.models.wind.apparent_wind`); ``rudder_slipstream``: its terms x
+        ``magnitude``.
     n_runs : int
         Number of runs (1 .. 8).
     dt : float
@@ -842,7 +947,7 @@ def generate_vmm_runs(
     noise : bool
         Add the sensor noise :data:`VMM_NOISE`.
     seed : int
-        Seed of the current direction, the random rudder and the noise.
+        Seed (>= 0) of the current direction, the random rudder and the noise.
     magnitude : float
         Size of the effect relative to its default (> 0).
 
@@ -853,17 +958,13 @@ def generate_vmm_runs(
         with ``effect="wind"``); ``meta["particulars"]`` holds the ship (no coefficients) so
         that identification can read it, ``meta["truth"]`` the true model and effect, for
         tests only.
-    """
-    from shipgym.models import make_model
 
-    if effect is not None and effect not in VMM_EFFECTS:
-        raise ValueError(f"unknown effect {effect!r}; expected None or one of {VMM_EFFECTS}")
-    if not (isinstance(n_runs, int) and 1 <= n_runs <= len(VMM_RUNS)):
-        raise ValueError(f"n_runs must be an integer in [1, {len(VMM_RUNS)}], got {n_runs!r}")
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and 0.01 <= dt <= 0.5):
-        raise ValueError(f"dt must be in [0.01, 0.5] s, got {dt!r}")
-    if not (isinstance(magnitude, int | float) and math.isfinite(magnitude) and magnitude > 0):
-        raise ValueError(f"magnitude must be a finite number > 0, got {magnitude!r}")
+    Raises
+    ------
+    ValueError
+        For an unknown effect, or an ``n_runs``, ``dt``, ``seed`` or ``magnitude`` out of range.
+    """
+    _check_runs_arguments(effect, VMM_EFFECTS, n_runs, len(VMM_RUNS), dt, seed, magnitude)
     rng_cur, rng_man, rng_noise = (
         np.random.default_rng(s) for s in np.random.SeedSequence(int(seed)).spawn(3)
     )
@@ -886,46 +987,26 @@ def generate_vmm_runs(
     if wind_true:
         effect_params["wind_from"] = w_from
     particulars = {k: v for k, v in truth.to_dict().items() if k != "coefficients"}
-    h = dt / max(1, math.ceil(dt / 0.05 - 1e-9))  # integration step <= 0.05 s
-    every = round(dt / h)
+    h, every = _fine_step(dt)
     records = []
     for k, (kind, angle_deg, b, side) in enumerate(VMM_RUNS[:n_runs]):
         angle = math.radians(angle_deg)
         duration = 150.0 if kind != "turning" else 120.0
         n_fine = round(duration / h)
-        state = {"sign": side, "levels": None}
+        levels = None
         if kind == "random":
             times = np.arange(0.0, duration + b, b)
-            state["levels"] = (times, rng_man.uniform(-angle, angle, times.size))
+            levels = (times, rng_man.uniform(-angle, angle, times.size))
+        rudder = _RudderProgramme(kind, angle, b, side, duration, levels=levels)
 
         def apparent(x: np.ndarray) -> tuple[float, float]:
             if not wind_true:
                 return 0.0, 0.0
-            # relative air velocity in the body frame: true wind minus the ship's velocity
-            psi = x[2]
-            wx, wy = -w_speed * math.cos(w_from), -w_speed * math.sin(w_from)  # blowing to
-            ax = wx * math.cos(psi) + wy * math.sin(psi) - x[3]
-            ay = -wx * math.sin(psi) + wy * math.cos(psi) - x[4]
-            return math.hypot(ax, ay), math.atan2(-ay, -ax)  # angle it comes from, off the bow
+            return apparent_wind(w_speed, w_from, x[2], x[3], x[4])
 
-        def controller(
-            t: float, x: np.ndarray, kind: str = kind, angle: float = angle, b: float = b,
-            state: dict[str, Any] = state, duration: float = duration,
-        ) -> np.ndarray:  # fmt: skip
-            if kind == "zigzag":
-                psi_deg = math.degrees(x[2])
-                if state["sign"] > 0 and psi_deg > b:
-                    state["sign"] = -1.0
-                elif state["sign"] < 0 and psi_deg < -b:
-                    state["sign"] = 1.0
-                delta = state["sign"] * angle
-            elif kind == "turning":
-                delta = state["sign"] * angle if t < duration - b else 0.0
-            else:
-                times, levels = state["levels"]
-                delta = float(levels[np.searchsorted(times, t, side="right") - 1])
+        def controller(t: float, x: np.ndarray, rudder: _RudderProgramme = rudder) -> np.ndarray:
             thrust = thrust0 * (1.3 - 0.3 * x[3] / u0)
-            return np.array([delta, thrust, *apparent(x)])
+            return np.array([rudder(t, x[2]), thrust, *apparent(x)])
 
         x0 = np.zeros(7)
         x0[3] = u0
@@ -933,10 +1014,9 @@ def generate_vmm_runs(
         sel = slice(None, None, every)
         st = res.states[sel]
         inp = np.vstack((res.inputs, res.inputs[-1:]))[sel]
-        n = st.shape[0]
 
-        def noisy(a: np.ndarray, key: str, n: int = n) -> np.ndarray:
-            return a + rng_noise.normal(0.0, VMM_NOISE[key], n) if noise else a
+        def noisy(a: np.ndarray, key: str) -> np.ndarray:
+            return _noisy(rng_noise, noise, VMM_NOISE[key], a)
 
         u, v = noisy(st[:, 3], "uv"), noisy(st[:, 4], "uv")
         extra: dict[str, np.ndarray] = {}
@@ -968,6 +1048,263 @@ def generate_vmm_runs(
                         "coefficients": coefficients,
                         "effect": effect,
                         "effect_parameters": effect_params,
+                    },
+                },
+            )
+        )
+    return records
+
+
+# --------------------------------------------------------------------------------------------
+# 3-DOF model tests: runs of the MMG KVLCC2, a structure the VMM polynomials do not share
+
+
+MMG_EFFECTS: tuple[str, ...] = ("rudder_offset", "rudder_lag", "input_delay", "current", "wind")
+"""Undeclared effects of :func:`generate_mmg_runs`."""
+
+MMG_EFFECT_RANGES: dict[str, tuple[float, float]] = {
+    "rudder_offset": (math.radians(1.0), math.radians(2.0)),  # |delta_0| [rad]; sign drawn
+    "rudder_lag": (1.0, 1.4),  # steering-gear time constant [s]
+    "input_delay": (0.6, 1.0),  # tau [s]
+    "current": (0.04, 0.08),  # current speed over the approach speed [-]
+    "wind": (2.0, 3.0),  # true wind speed [m/s] (14 to 20 m/s at full scale)
+}
+"""Range of each effect's size at ``magnitude`` 1 (drawn uniformly from the seed, then
+multiplied by ``magnitude``), in the unit given."""
+
+#: The run programme: (kind, rudder angle [deg], switch heading [deg] or hold [s], side). The
+#: two 20/20 zigzags are third and sixth, the runs ``identify``'s default hold-out (every
+#: third run) keeps out.
+MMG_RUNS: tuple[tuple[str, float, float, float], ...] = (
+    ("zigzag", 10.0, 10.0, 1.0),
+    ("turning", 35.0, 0.0, 1.0),
+    ("zigzag", 20.0, 20.0, 1.0),
+    ("zigzag", 10.0, 10.0, -1.0),
+    ("turning", 35.0, 0.0, -1.0),
+    ("zigzag", 20.0, 20.0, -1.0),
+    ("zigzag", 15.0, 15.0, 1.0),
+    ("zigzag", 25.0, 5.0, -1.0),
+)
+
+MMG_DURATION = (90.0, 120.0)
+"""Range [s] of the length of each run (drawn per run)."""
+
+MMG_APPROACH = (2.0, 5.0)
+"""Range [s] of the straight approach before the rudder is put over (drawn per run)."""
+
+MMG_SPEED_SPREAD = 0.03
+"""Relative spread of each run's approach speed about the SIMMAN speed (drawn per run)."""
+
+MMG_NOISE: dict[str, float] = {
+    **{k: VMM_NOISE[k] for k in ("psi", "r", "uv", "xy", "wind_speed", "wind_angle")},
+    "delta": math.radians(0.1),
+    "rpm": 1.0,
+}
+"""Standard deviations of the sensor noise of :func:`generate_mmg_runs` (``rpm`` in rev/min,
+the others as :data:`VMM_NOISE`; ``delta`` [rad])."""
+
+
+def generate_mmg_runs(
+    effect: str | None = None,
+    *,
+    n_runs: int = 6,
+    dt: float = 0.1,
+    noise: bool = True,
+    seed: int = 0,
+    magnitude: float = 1.0,
+) -> list[Record]:
+    """Tank runs of the KVLCC2 L7 model (7 m) simulated by the MMG standard model with at most
+    one undeclared effect: zigzags and turning circles, in the order of :data:`MMG_RUNS`.
+
+    The ship is :func:`shipgym.models.make_model` ``("kvlcc2")`` (:mod:`shipgym.models.mmg`:
+    Yasukawa and Yoshimura 2015), whose hull, propeller and rudder forces are not the VMM
+    polynomials. Each run starts in straight running at an approach speed within
+    :data:`MMG_SPEED_SPREAD` of the SIMMAN speed (1.179 m/s) on a heading drawn from the seed,
+    with the propeller at that speed's self-propulsion revolutions, held constant (recorded as
+    ``rpm``; the thrust is not recorded), runs straight for :data:`MMG_APPROACH` s, then puts
+    the rudder over; each run lasts :data:`MMG_DURATION` s. The zigzags switch on the true
+    heading relative to the initial one.
+
+    Effects (their size drawn once per call from :data:`MMG_EFFECT_RANGES`, times
+    ``magnitude``):
+
+    * ``rudder_offset``: the actual rudder is the recorded one plus ``delta_0`` (sign drawn
+      too): the gear is ordered the programme's command plus ``delta_0``, and the record holds
+      the gear's angle less ``delta_0``.
+    * ``rudder_lag``: a slow steering gear, first-order with time constant ``T_delta``
+      (``MMGParams.rudder_time_constant``; the model's own is 0.05 s, inside its 15.7 deg/s
+      rate limit), and the record holds the COMMAND. Without it the record holds the actual
+      rudder angle.
+    * ``input_delay``: the recorded rudder leads the actual one by ``tau`` (rounded to the
+      integration step): the gear is ordered the command ``tau`` late and the record holds
+      the gear's angle ``tau`` ahead.
+    * ``current``: a constant current toward a direction drawn from the seed, of the given
+      fraction of the approach speed; the ship starts steady in the water.
+    * ``wind``: a constant true wind from a direction drawn from the seed, with Blendermann's
+      loads on the KVLCC2's estimated wind areas (``MMGParams.wind_speed``,
+      :mod:`shipgym.models.wind`); the records carry the apparent wind at the ship,
+      ``wind_speed`` and ``wind_angle`` (the direction it comes from, clockwise from the bow).
+
+    Parameters
+    ----------
+    effect : {"rudder_offset", "rudder_lag", "input_delay", "current", "wind"} or None
+        The undeclared effect (None: the clean ship).
+    n_runs : int
+        Number of runs (1 .. 8; the default 6 are two each of 10/10 and 20/20 zigzags and
+        35 deg turns, to both sides).
+    dt : float
+        Sampling interval [s] (0.01 .. 0.5).
+    noise : bool
+        Add the sensor noise :data:`MMG_NOISE` to every channel (its draws come from their own
+        random stream: ``noise=False`` gives the same motions).
+    seed : int
+        Seed (>= 0) of the effect's size and direction, the runs' headings, speeds, approach
+        and lengths, and the noise.
+    magnitude : float
+        Size of the effect relative to its range (> 0).
+
+    Returns
+    -------
+    list of Record
+        ``time, delta, psi, r, x, y, u, v, U, rpm`` (and ``wind_speed``, ``wind_angle`` with
+        ``effect="wind"``); ``x, y`` north and east of the start, ``u, v`` over ground. The meta
+        states the ship's main particulars as plain keys (``L``, ``B``, ``draft``,
+        ``displacement_m3``, ``x_G``, ``propeller_diameter`` [m, m^3], ``rho`` [kg/m^3]);
+        ``meta["truth"]`` holds the true model, effect and its parameters, for tests only: an
+        identifier must not read it.
+
+    Raises
+    ------
+    ValueError
+        For an unknown effect, or an ``n_runs``, ``dt``, ``seed`` or ``magnitude`` out of range.
+    """
+    _check_runs_arguments(effect, MMG_EFFECTS, n_runs, len(MMG_RUNS), dt, seed, magnitude)
+    rng_effect, rng_programme, rng_noise = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(int(seed)).spawn(3)
+    )
+    base = MMGParams.kvlcc2()
+    params = base
+    current = np.zeros(2)
+    effect_params: dict[str, Any] = {}
+    offset = 0.0
+    delay_steps = 0
+    h, every = _fine_step(dt)
+    if effect is not None:
+        size = magnitude * float(rng_effect.uniform(*MMG_EFFECT_RANGES[effect]))
+        if effect == "rudder_offset":
+            offset = size * float(rng_effect.choice([-1.0, 1.0]))
+            effect_params = {"delta_0": offset}
+        elif effect == "rudder_lag":
+            params = replace(base, rudder_time_constant=size)
+            effect_params = {"T_delta": size}
+        elif effect == "input_delay":
+            delay_steps = max(1, round(size / h))
+            effect_params = {"tau": delay_steps * h, "tau_requested": size}
+        elif effect == "current":
+            current, effect_params = _draw_current(rng_effect, size * KVLCC2_SIMMAN_SPEED)
+        else:
+            direction = float(rng_effect.uniform(0.0, 2.0 * math.pi))
+            params = replace(base, wind_speed=size, wind_direction=direction)
+            effect_params = {"speed": size, "direction": direction}
+    model = make_model("kvlcc2", params)
+    meta_ship = {
+        "vessel": "KVLCC2 L7 model (MMG standard model, Yasukawa and Yoshimura 2015)",
+        "L": base.length,
+        "B": base.breadth,
+        "draft": base.draught,
+        "displacement_m3": base.displacement,
+        "x_G": base.x_g,
+        "propeller_diameter": base.propeller_diameter,
+        "rho": base.rho,
+    }
+    records = []
+    for k, (kind, angle_deg, b, side) in enumerate(MMG_RUNS[:n_runs]):
+        duration = float(rng_programme.uniform(*MMG_DURATION))
+        start = float(rng_programme.uniform(*MMG_APPROACH))
+        psi0 = float(rng_programme.uniform(0.0, 2.0 * math.pi))
+        speed = KVLCC2_SIMMAN_SPEED * (1.0 + float(rng_programme.uniform(-1.0, 1.0))
+                                       * MMG_SPEED_SPREAD)  # fmt: skip
+        rps = base.self_propulsion_rps(speed)  # the calm-water set-point of the tank
+        n_samples = math.floor(duration / dt + 1e-9) + 1
+        n_fine = (n_samples - 1) * every
+        rudder = _RudderProgramme(kind, math.radians(angle_deg), b, side, math.inf, psi0, start)
+        commands: list[float] = []
+
+        def controller(
+            t: float, x: np.ndarray, rudder: _RudderProgramme = rudder,
+            commands: list[float] = commands, rps: float = rps,
+        ) -> list[float]:  # fmt: skip
+            commands.append(rudder(t, x[_mmg.IPSI]))
+            j = len(commands) - 1 - delay_steps
+            return [(commands[j] if j >= 0 else 0.0) + offset, rps]
+
+        x0 = np.zeros(model.nx)
+        x0[_mmg.IPSI] = psi0
+        cs, sn = math.cos(psi0), math.sin(psi0)
+        x0[_mmg.IU] = speed + current[0] * cs + current[1] * sn  # steady in the water
+        x0[_mmg.IV] = -current[0] * sn + current[1] * cs
+        x0[_mmg.IDELTA] = offset
+        res = model.simulate(x0, controller, h, n_fine + delay_steps + 1, current=current)
+        idx = np.arange(n_samples) * every
+        st = res.states[idx]
+        if effect == "rudder_lag":
+            delta = np.asarray(commands)[idx]
+        else:
+            delta = res.states[idx + delay_steps, _mmg.IDELTA] - offset
+
+        def noisy(a: np.ndarray, key: str) -> np.ndarray:
+            return _noisy(rng_noise, noise, MMG_NOISE[key], a)
+
+        u, v = noisy(st[:, _mmg.IU], "uv"), noisy(st[:, _mmg.IV], "uv")
+        extra: dict[str, np.ndarray] = {}
+        if effect == "wind":
+            apparent = np.array([
+                apparent_wind(params.wind_speed, params.wind_direction, s[_mmg.IPSI], s[_mmg.IU],
+                              s[_mmg.IV])
+                for s in st
+            ])  # fmt: skip
+            extra["wind_speed"] = np.abs(noisy(apparent[:, 0], "wind_speed"))
+            extra["wind_angle"] = wrap_angle(noisy(apparent[:, 1], "wind_angle"))
+        label = f"{kind} {angle_deg:g}" + (f"/{b:g}" if kind == "zigzag" else "")
+        records.append(
+            Record(
+                time=idx * h,
+                delta=noisy(delta, "delta"),
+                psi=noisy(st[:, _mmg.IPSI], "psi"),
+                r=noisy(st[:, _mmg.IR], "r"),
+                x=noisy(st[:, _mmg.IX], "xy"),
+                y=noisy(st[:, _mmg.IY], "xy"),
+                u=u,
+                v=v,
+                U=np.hypot(u, v),
+                rpm=noisy(np.full(n_samples, 60.0 * rps), "rpm"),
+                **extra,
+                meta={
+                    "source": "generated",
+                    "file": f"MMG run {k + 1} ({label} {'starboard' if side > 0 else 'port'})",
+                    **meta_ship,
+                    "scale": "model",
+                    "frame": "x north, y east [m] from the start position",
+                    "r_source": "measured",
+                    "maneuver": kind,
+                    "dt": dt,
+                    "seed": int(seed),
+                    "noise": dict(MMG_NOISE) if noise else None,
+                    "notes": [
+                        "synthetic record; meta['truth'] is the ground truth for tests only and "
+                        "must not be read by an identifier"
+                    ],
+                    "truth": {
+                        "model": "kvlcc2",
+                        "params": asdict(params),
+                        "current": current.tolist(),
+                        "effect": effect,
+                        "effect_parameters": effect_params,
+                        "magnitude": magnitude,
+                        "x0": x0.tolist(),
+                        "rps": rps,
+                        "approach_s": start,
+                        "fine_step": h,
                     },
                 },
             )

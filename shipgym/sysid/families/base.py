@@ -335,9 +335,13 @@ class ModelFamily(ABC):
 
         The most negative ``delta_J`` wins; candidates within :data:`TIE_FRACTION` of it are
         tied and the one adding the fewest parameters wins (a correlated simulation residual
-        makes small BIC differences moot).
+        makes small BIC differences moot). Against a current model whose held-out prediction
+        diverges every finite candidate has ``delta_J = -inf``: the lowest held-out BIC of
+        its own wins then.
         """
-        best = min(good, key=lambda k: good[k][1])
+        best = min(good, key=lambda k: (good[k][1], good[k][0].J))
+        if not math.isfinite(good[best][1]):
+            return best
         tied = [k for k in good if good[k][1] <= (1.0 - TIE_FRACTION) * good[best][1]]
         return min(tied, key=lambda k: (self.catalogue[k].n_added, good[k][1]))
 

@@ -1,0 +1,296 @@
+"""The 3-DOF identification loop on tank records it did not make: the MMG KVLCC2 with one
+undeclared effect.
+
+Usage::
+
+    python scripts/identify_mmg_records.py [--model vmm:auto] [--seeds 6] [--effects E ...]
+                                           [--n-runs 6] [--jobs 2] [--out docs]
+                                           [--readme README.md | --no-readme]
+
+For every effect of :data:`shipgym.sysid.generator.MMG_EFFECTS` and the clean ship, and every
+seed ``0 .. seeds-1``, :func:`shipgym.sysid.generator.generate_mmg_runs` makes the runs of the
+KVLCC2 L7 model (7 m) simulated by the MMG standard model (Yasukawa and Yoshimura 2015): 90-120 s
+of 10/10 and 20/20 zigzags and 35 deg turns to both sides, noise on every channel, the ship's
+main particulars as plain meta keys; the effect's size and direction, the headings, speeds and
+lengths come from the seed. :func:`shipgym.sysid.identify` fits them with ``--model`` (default
+``vmm:auto``, or ``vmm:martin_simple`` where ``vmm:auto`` is not registered) and its default
+hold-out (every third run: the two 20/20 zigzags). Only the records are read, never their
+``meta["truth"]``.
+
+Printed and written per effect: how often the undeclared effect is the first one named, how
+often the held-out heading RMS is at least halved (``heldout["error_before"]`` against
+``heldout["error_after"]``; a base model that diverges on them counts as halved), how often
+both; for the clean records how often no actuator effect
+(:data:`ACTUATOR_EFFECTS`) is named. The target is at least 5 of 6 seeds for each.
+
+Writes ``OUT/mmg_records.json``, ``OUT/mmg_records.png`` and the README block between
+``<!-- mmg_records -->`` and ``<!-- /mmg_records -->``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.ticker import ScalarFormatter
+
+from shipgym.sysid import identify
+from shipgym.sysid.families.base import FAMILIES
+from shipgym.sysid.generator import MMG_EFFECTS, generate_mmg_runs
+from shipgym.sysid.report import replace_between_markers, update_readme, write_json
+
+REPO = Path(__file__).resolve().parents[1]
+DEFAULT_MODEL = "vmm:auto"
+FALLBACK_MODEL = "vmm:martin_simple"
+ACTUATOR_EFFECTS = ("rudder_offset", "rudder_lag", "input_delay")
+"""Effects of the rudder and its gear (a clean record must name none of them)."""
+TARGET = 5
+"""Seeds of six that must pass."""
+CLEAN = "clean"
+
+
+def _say(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+def _psi(errors: dict[str, Any] | None) -> float:
+    value = (errors or {}).get("psi_rms_deg")
+    return float(value) if isinstance(value, int | float) else math.nan
+
+
+def _case(task: tuple[str | None, int, str, int]) -> dict[str, Any]:
+    """Generate one effect and seed and identify it (a process-pool task)."""
+    effect, seed, model, n_runs = task
+    row: dict[str, Any] = {"effect": effect or CLEAN, "seed": seed}
+    t0 = time.perf_counter()
+    runs = generate_mmg_runs(effect, seed=seed, n_runs=n_runs)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = identify(runs, model)
+    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+        return row | {"error": f"{type(exc).__name__}: {exc}", "runtime_s": 0.0}
+    named = res.effect_names
+    before, after = _psi(res.heldout.get("error_before")), _psi(res.heldout.get("error_after"))
+    row |= {
+        "named": named,
+        "first": named[0] if named else None,
+        "heldout_psi_before_deg": before,
+        "heldout_psi_after_deg": after,
+        # a base model that diverges on the held-out runs (no finite error) counts as halved
+        "halved": bool(math.isfinite(after) and not after > 0.5 * before),
+        "actuator_named": [e for e in named if e in ACTUATOR_EFFECTS],
+        "effect_parameters": {e["name"]: e["parameters"] for e in res.effects},
+        "runtime_s": time.perf_counter() - t0,
+    }
+    if effect is not None:
+        row["named_first"] = row["first"] == effect
+        row["passed"] = row["named_first"] and row["halved"]
+    else:
+        row["passed"] = not row["actuator_named"]
+    return row
+
+
+def _median(values: list[float]) -> float:
+    """Median of the finite values (NaN if none: a diverged simulation has no error)."""
+    finite = [v for v in values if v is not None and math.isfinite(v)]
+    return float(np.median(finite)) if finite else math.nan
+
+
+def summarise(rows: list[dict[str, Any]], effects: list[str]) -> dict[str, dict[str, Any]]:
+    """Counts per effect over the seeds (failed identifications count as misses)."""
+    out = {}
+    for effect in effects:
+        mine = [r for r in rows if r["effect"] == effect]
+        ok = [r for r in mine if "error" not in r]
+        entry: dict[str, Any] = {
+            "seeds": len(mine),
+            "failed": len(mine) - len(ok),
+            "passed": sum(r["passed"] for r in ok),
+            "halved": sum(r["halved"] for r in ok),
+            "median_before_deg": _median([r["heldout_psi_before_deg"] for r in ok]),
+            "median_after_deg": _median([r["heldout_psi_after_deg"] for r in ok]),
+        }
+        if effect == CLEAN:
+            entry["no_actuator_effect"] = entry["passed"]
+            entry["no_effect"] = sum(not r["named"] for r in ok)
+        else:
+            entry["named_first"] = sum(r["named_first"] for r in ok)
+        entry["target_met"] = entry["passed"] >= math.ceil(TARGET / 6 * len(mine))
+        out[effect] = entry
+    return out
+
+
+def _f(x: Any, fmt: str = ".2f") -> str:
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
+
+
+def render(doc: dict[str, Any]) -> str:
+    """The README block."""
+    n = doc["n_seeds"]
+    lines = [
+        f"The 3-DOF loop (`{doc['model']}`) on runs of the KVLCC2 L7 model made by the MMG "
+        f"standard model, a structure its polynomials do not share: {doc['n_runs']} runs of "
+        "90-120 s (10/10 and 20/20 zigzags and 35 deg turns to both sides) with noise on every "
+        f"channel and one undeclared effect, {n} seed{'s' if n != 1 else ''} each; every "
+        "third run (the 20/20 zigzags) held out. "
+        f"Target: at least {TARGET} of 6 seeds.",
+        "",
+        "| records | named first | held-out heading RMS halved | both | median held-out "
+        "heading RMS before → after [deg] | effects named (per seed) |",
+        "|---|---:|---:|---:|---:|---|",
+    ]
+    for effect, s in doc["summary"].items():
+        named = "; ".join(
+            ", ".join(r["named"]) or "none" if "error" not in r else "failed"
+            for r in doc["rows"] if r["effect"] == effect
+        )  # fmt: skip
+        first = (
+            f"{s['no_actuator_effect']}/{n} no actuator effect"
+            if effect == CLEAN
+            else f"{s['named_first']}/{n}"
+        )
+        both = "" if effect == CLEAN else f"{s['passed']}/{n}"
+        lines.append(
+            f"| {effect.replace('_', ' ')} | {first} | {s['halved']}/{n} | {both} | "
+            f"{_f(s['median_before_deg'])} → {_f(s['median_after_deg'])} | {named} |"
+        )
+    failed = sum(s["failed"] for s in doc["summary"].values())
+    if failed:
+        lines += ["", f"{failed} identifications failed (see `docs/mmg_records.json`)."]
+    lines += ["", f"Made by `python scripts/identify_mmg_records.py` in {doc['runtime_s']:.0f} s."]
+    return "\n".join(lines)
+
+
+def plot(doc: dict[str, Any], path: Path) -> None:
+    """Held-out heading RMS before and after per effect and seed; the named-first rates."""
+    effects = list(doc["summary"])
+    fig, axes = plt.subplots(1, 2, figsize=(14, 4.8), constrained_layout=True,
+                             gridspec_kw={"width_ratios": [2, 1]})  # fmt: skip
+    ax = axes[0]
+    for i, effect in enumerate(effects):
+        rows = [r for r in doc["rows"] if r["effect"] == effect and "error" not in r]
+        for j, r in enumerate(rows):
+            x = i + 0.1 * (j - (len(rows) - 1) / 2)
+            b, a = r["heldout_psi_before_deg"], r["heldout_psi_after_deg"]
+            ax.plot([x, x], [b, a], "-", color="0.6", lw=1)
+            ax.plot(x, b, "o", mfc="white", mec="C0")
+            ax.plot(x, a, "o", color="C2" if r["passed"] else "C3")
+    ax.set_xticks(range(len(effects)), [e.replace("_", " ") for e in effects])
+    ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.set_ylabel("held-out heading RMS [deg]")
+    ax.set_title(f"{doc['model']} on MMG-made records: each seed before and after the loop")
+    ax.legend(handles=[
+        Line2D([], [], ls="", marker="o", mfc="white", mec="C0", label="before (base model)"),
+        Line2D([], [], ls="", marker="o", color="C2", label="after, passed"),
+        Line2D([], [], ls="", marker="o", color="C3", label="after, missed"),
+    ], fontsize=8)  # fmt: skip
+    ax = axes[1]
+    n = doc["n_seeds"]
+    x = np.arange(len(effects))
+    s = doc["summary"]
+    first = [s[e]["no_actuator_effect" if e == CLEAN else "named_first"] / n for e in effects]
+    ax.bar(x - 0.2, first, 0.4, label="named first (clean: no actuator effect)")
+    ax.bar(x + 0.2, [s[e]["halved"] / n for e in effects], 0.4, label="held-out error halved")
+    ax.axhline(TARGET / 6, color="k", lw=0.8, ls="--", label=f"target {TARGET}/6")
+    ax.set_xticks(x, [e.replace("_", " ") for e in effects], rotation=30)
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("fraction of seeds")
+    ax.legend(fontsize=8, loc="lower left")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--model", default=DEFAULT_MODEL, help=f"model (default {DEFAULT_MODEL})")
+    ap.add_argument("--seeds", type=int, default=6, help="seeds 0 .. N-1 (default 6)")
+    kinds = [CLEAN, *MMG_EFFECTS]
+    ap.add_argument("--effects", nargs="+", choices=kinds, default=kinds,
+                    help="records to make (default all)")  # fmt: skip
+    ap.add_argument("--n-runs", type=int, default=6, help="runs per record set (default 6)")
+    ap.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
+    ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
+    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
+    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    args = ap.parse_args(argv)
+    if args.seeds < 1:
+        ap.error(f"--seeds must be >= 1, got {args.seeds}")
+    if not args.no_readme:  # before an hour of fits, not after
+        try:
+            text = Path(args.readme).read_text(encoding="utf-8")
+            replace_between_markers(text, "mmg_records", "")
+        except (OSError, ValueError) as exc:
+            ap.error(f"--readme {args.readme}: {exc} (or pass --no-readme)")
+    model = args.model
+    if model == DEFAULT_MODEL and model not in FAMILIES:
+        _say(f"{DEFAULT_MODEL} is not registered; using {FALLBACK_MODEL}")
+        model = FALLBACK_MODEL
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tasks = [(None if e == CLEAN else e, seed, model, args.n_runs)
+             for e in args.effects for seed in range(args.seeds)]  # fmt: skip
+    _say(f"{len(tasks)} identifications with {model} on {args.jobs} processes ...")
+    t0 = time.perf_counter()
+    rows = []
+    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        futures = [pool.submit(_case, task) for task in tasks]
+        for k, fut in enumerate(as_completed(futures)):
+            r = fut.result()
+            rows.append(r)
+            if "error" in r:
+                _say(f"  {k + 1}/{len(tasks)} {r['effect']} seed {r['seed']}: {r['error']}")
+                continue
+            _say(
+                f"  {k + 1}/{len(tasks)} {r['effect']} seed {r['seed']}: named "
+                f"{', '.join(r['named']) or 'none'}; held-out psi "
+                f"{r['heldout_psi_before_deg']:.2f} -> {r['heldout_psi_after_deg']:.2f} deg "
+                f"({'passed' if r['passed'] else 'missed'}, {r['runtime_s']:.0f} s)"
+            )
+    order = {e: i for i, e in enumerate(args.effects)}
+    rows.sort(key=lambda r: (order[r["effect"]], r["seed"]))
+    summary = summarise(rows, args.effects)
+    doc = {
+        "model": model,
+        "n_seeds": args.seeds,
+        "n_runs": args.n_runs,
+        "actuator_effects": list(ACTUATOR_EFFECTS),
+        "target_seeds": TARGET,
+        "summary": summary,
+        "rows": rows,
+        "runtime_s": time.perf_counter() - t0,
+    }
+    for effect, s in summary.items():
+        what = (
+            f"no actuator effect {s['no_actuator_effect']}/{s['seeds']}"
+            if effect == CLEAN
+            else f"named first {s['named_first']}/{s['seeds']}, both {s['passed']}/{s['seeds']}"
+        )
+        print(
+            f"{effect:>14}: {what}, held-out heading halved {s['halved']}/{s['seeds']}, "
+            f"median {_f(s['median_before_deg'])} -> {_f(s['median_after_deg'])} deg"
+            f"{'' if s['target_met'] else '  (target missed)'}"
+        )
+    write_json(doc, out / "mmg_records.json")
+    plot(doc, out / "mmg_records.png")
+    if not args.no_readme:
+        update_readme(Path(args.readme), render(doc), "mmg_records")
+    _say(f"wrote {out / 'mmg_records.json'} and .png in {doc['runtime_s']:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
