@@ -335,6 +335,36 @@ def test_a_fitted_vmm_writes_its_actuator_causes_in_the_model_file(tmp_path: Pat
     assert model.input_delay == 0.4
 
 
+def test_an_effect_whose_parameter_ends_at_its_bound_is_not_accepted() -> None:
+    """The bound, not the record, chose such a value: the engine's criterion refuses it
+    however much the held-out score drops."""
+    from shipgym.sysid.families.base import FAMILIES, Candidate
+
+    family = FAMILIES["vmm:linear"]
+    free = Candidate(("rudder_lag",), None, -100.0, 0.1)
+    assert family.significant(free, "rudder_lag", -500.0, 0.5)
+    bound = Candidate(("rudder_lag",), None, -100.0, 0.1, extra={"at_bound": "T_d = 0.1"})
+    assert not family.significant(bound, "rudder_lag", -500.0, 0.5)
+
+
+def test_on_records_of_the_mmg_model_a_rudder_zero_error_is_named() -> None:
+    """Data the family did not make: the MMG KVLCC2 (its own hull, propeller and rudder
+    forces) with a rudder zero error it does not declare, the ship given by its main
+    particulars only. The loop names the offset first, with the sign of the truth, and halves
+    the held-out heading error."""
+    from shipgym.sysid.generator import generate_mmg_runs
+
+    runs = generate_mmg_runs("rudder_offset", seed=0)
+    assert "particulars" not in runs[0].meta and runs[0].meta["L"] == 7.0
+    result = identify(runs, "vmm:martin_simple", max_effects=1)
+    assert result.effect_names == ["rudder_offset"]
+    truth = runs[0].meta["truth"]["effect_parameters"]["delta_0"]
+    found = result.effects[0]["parameters"]["delta0"]
+    assert np.sign(found) == np.sign(truth) and 0.5 < found / truth < 2.0
+    held = result.heldout
+    assert held["error_after"]["psi_rms_deg"] < 0.5 * held["error_before"]["psi_rms_deg"]
+
+
 def test_single_run_families_refuse_several_records(wind_runs) -> None:
     with pytest.raises(ValueError, match="one record at a time"):
         identify(wind_runs[:2], "nomoto1")

@@ -154,11 +154,14 @@ CAUSES: dict[str, Effect] = {
         ),
         Effect(
             "wind",
-            "X_wc (V_w/U)^2 cos g, Y_ws (V_w/U)^2 sin g, N_w2 (V_w/U)^2 sin 2g",
-            ("X_wc", "Y_ws", "N_w2"),
+            "X_wc (V_w/U)^2 cos g, Y_ws (V_w/U)^2 sin g, "
+            "N_ws (V_w/U)^2 sin g + N_w2 (V_w/U)^2 sin 2g",
+            ("X_wc", "Y_ws", "N_ws", "N_w2"),
             {},
             "apparent-wind loads with the angular forms of Isherwood (1972) and Fossen (2011, "
-            "eq. 8.23); needs the record's wind channels",
+            "eq. 8.23); the yaw moment's sin g part is the lateral area's centre off midship "
+            "(Blendermann 1994: N = (s_L / L - 0.18 (g - pi/2)) C_Y); needs the record's wind "
+            "channels",
         ),
     )
 }
@@ -327,7 +330,11 @@ class ModelFamily(ABC):
 
     def significant(self, cand: Candidate, name: str, delta_j: float, drop: float) -> bool:
         """The engine's criterion: the BIC drops by :data:`BIC_MARGIN` and the held-out error
-        by :attr:`min_relative_drop`."""
+        by :attr:`min_relative_drop`, and no parameter of the effect ended at a bound of its
+        fit (``cand.extra["at_bound"]``, set by the family: the bound, not the record, chose
+        its value)."""
+        if cand.extra.get("at_bound"):
+            return False
         return bool(delta_j < -BIC_MARGIN and drop > self.min_relative_drop)
 
     def choose(self, good: Mapping[str, tuple[Candidate, float]]) -> str:

@@ -144,6 +144,17 @@ VMM_EFFECTS: dict[str, Effect] = {
         "the rudder in the propeller slipstream: its force grows with the thrust loading (MMG "
         "eq. 40-42; the seed's Y_thrustdelta)",
     ),
+    "turn_asymmetry": Effect(
+        "turn_asymmetry",
+        "Y_|v| |v'|, N_|v| |v'|, Y_|r| |r'|, N_|r| |r'| (even in sway and yaw, prime)",
+        ("Y_|v|", "N_|v|", "Y_|r|", "N_|r|"),
+        {},
+        "a single-screw ship turns differently to port and to starboard with no force in "
+        "straight running: the propeller's rotation makes the rudder's flow straightening and "
+        "the wake differ with the sign of the drift (MMG gamma_R and C_2 of each side, "
+        "Yasukawa and Yoshimura 2015 eq. 16, 38 and Table 4); a rudder zero error acts in "
+        "straight running too",
+    ),
     "wind": CAUSES["wind"],
 }
 """The effects of the VMM family (module docstring): the shared causes
@@ -164,7 +175,8 @@ and a propeller side force compete as causes."""
 _EFFECT_TERMS = {
     "asymmetry": ("Y_0", "N_0"),
     "rudder_slipstream": ("Y_Td", "N_Td"),
-    "wind": ("X_wc", "Y_ws", "N_w2"),
+    "wind": ("X_wc", "Y_ws", "N_ws", "N_w2"),
+    "turn_asymmetry": ("Y_|v|", "N_|v|", "Y_|r|", "N_|r|"),
 }
 
 
@@ -1054,6 +1066,18 @@ def _replay_cost(rp: _Replay, runs: Sequence[int], fit: Any, weights_of: Any) ->
     return float(np.sum(e * e))
 
 
+def _flag_bound(cand: Candidate, name: str, rp: _Replay) -> Candidate:
+    """``cand`` with ``extra["at_bound"]`` saying so when the parameter of actuator cause
+    ``name`` ended within 0.5 % of the range of a bound of :func:`actuator_bounds` (the engine
+    then does not accept it: the bound, not the records, chose the value)."""
+    key = CAUSES[name].parameters[0]
+    value = cand.fitted.actuators.get(key)
+    lo, hi = actuator_bounds(name, _travel_s(rp, cand.fitted.params.length))
+    if value is not None and min(value - lo, hi - value) <= 0.005 * (hi - lo):
+        cand.extra["at_bound"] = f"{key} = {value:.4g} at a bound of ({lo:.4g}, {hi:.4g})"
+    return cand
+
+
 def search_actuator(rp: _Replay, runs: Sequence[int], fit: Any, name: str) -> dict[str, float]:
     """``fit``'s actuator parameters with that of cause ``name`` added at the value that
     minimises the weighted replay error of ``runs`` with the rest of the model fixed (a
@@ -1273,7 +1297,7 @@ class VMMFamily(ModelFamily):
         if name in ACTUATOR_CAUSES:
             act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
             screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False, act))
-            return self._candidate(ctx, effects, screen)
+            return _flag_bound(self._candidate(ctx, effects, screen), name, ctx.rp_fit)
         fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
         drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
         if not self.refine or drop < SCREEN_MIN_DROP:
@@ -1563,7 +1587,7 @@ class MMGFamily(VMMFamily):
         if name in ACTUATOR_CAUSES:  # the parameter starts where the current model fits best
             act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
             fit = self._fit(ctx, effects, ctx.train, True, current.fitted, act)
-            return self._score(ctx, fit)
+            return _flag_bound(self._score(ctx, fit), name, ctx.rp_fit)
         return self._score(ctx, self._fit(ctx, effects, ctx.train, True, current.fitted))
 
     def _refit_all(self, ctx: _Context, cand: Candidate) -> MMGFit:
