@@ -1,4 +1,4 @@
-"""Tests of shipgym.sysid.nmea: NMEA 0183 logs written from a simulated zigzag and read back.
+"""Tests of shipgym.sysid.io.nmea: NMEA 0183 logs written from a simulated zigzag and read back.
 
 The ship is a first-order Nomoto model (K = 0.1 1/s, T = 30 s) steered through a 10/10 zigzag
 after 20 s of straight running; :func:`write_nmea` samples it at mixed rates (HDT 10 Hz, ROT and
@@ -25,13 +25,8 @@ from pynmeagps import calc_checksum
 
 from shipgym.models import Nomoto1Params, SteeringGear, make_model
 from shipgym.sysid.data import Record, SysidDataWarning
-from shipgym.sysid.nmea import (
-    DEFAULT_RATES,
-    NMEA_LOGGER_STYLES,
-    load_nmea,
-    looks_like_nmea,
-)
-from shipgym.sysid.nmea_writer import write_nmea
+from shipgym.sysid.io.nmea import NMEA_LOGGER_STYLES, load_nmea, looks_like_nmea
+from shipgym.sysid.nmea_writer import DEFAULT_RATES, write_nmea
 
 START = datetime.datetime(2026, 12, 31, 23, 59, 30, tzinfo=datetime.UTC)
 KNOT = 1852.0 / 3600.0

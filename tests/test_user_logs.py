@@ -27,8 +27,8 @@ from shipgym.models.delay import DelayLine
 from shipgym.models.model_file import load_model, nomoto_document
 from shipgym.sysid import Record, generate_record, identify, load
 from shipgym.sysid.data import SysidDataWarning, measured_root
+from shipgym.sysid.io.table import parse_columns
 from shipgym.sysid.nmea_writer import write_nmea
-from shipgym.sysid.table import parse_columns
 
 pytestmark = pytest.mark.xdist_group("test_user_logs")
 

@@ -79,15 +79,22 @@ from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.kinematics import relative_motion, steering_gear
 
 __all__ = [
+    "DEFAULT_FROUDE_NUMBER",
     "FACTORS",
+    "IMO_RATE_LENGTH",
+    "IMO_RUDDER_RATE",
     "MIN_SPEED_FRACTION",
+    "PARTICULARS",
+    "PARTICULAR_SPELLINGS",
     "TERM_SETS",
     "VMM_INPUTS",
     "VMM_STATES",
     "VMMParams",
     "check_packed",
     "clarke_added_masses",
+    "find_particulars",
     "pack_vmm",
+    "parse_particulars",
     "parse_term",
     "propeller_loading",
     "term_matrix",
@@ -211,6 +218,163 @@ def clarke_added_masses(
         "N_vdot": k * (1.1 * b_l - 0.041 * b_t),
         "N_rdot": k * (1.0 / 12.0 + 0.017 * cb * b_t - 0.33 * b_l),
     }
+
+
+PARTICULARS: dict[str, str] = {
+    "length": "length L [m]",
+    "breadth": "breadth B [m]",
+    "draught": "draught T [m]",
+    "displacement": "displacement volume [m^3] (or mass)",
+    "mass": "mass [kg] (or displacement)",
+    "x_g": "centre of gravity forward of midship [m]",
+    "propeller_diameter": "propeller diameter [m] (optional)",
+    "rho": "water density [kg/m^3] (optional, 1025)",
+    "yaw_radius": "yaw radius of gyration [m] (optional, 0.25 L)",
+    "block_coefficient": "block coefficient (optional, displacement / (L B T))",
+    "approach_speed": "approach speed [m/s] (optional)",
+}
+"""The main particulars of :meth:`VMMParams.from_particulars` (the keys of
+:func:`parse_particulars`) and what each is, in SI units."""
+
+_REQUIRED_PARTICULARS = ("length", "breadth", "draught", "x_g")
+
+PARTICULAR_SPELLINGS: dict[str, tuple[str, ...]] = {
+    "length": ("length", "L", "Lpp", "LPP", "L_pp", "length_m"),
+    "breadth": ("breadth", "B", "beam", "breadth_m"),
+    "draught": ("draught", "draft", "draught_m", "draft_m"),
+    "displacement": ("displacement", "displacement_m3", "volume", "nabla"),
+    "mass": ("mass", "mass_kg"),
+    "x_g": ("x_g", "x_G", "xG", "x_g_m"),
+    "propeller_diameter": ("propeller_diameter", "D_p", "Dp", "propeller_diameter_m"),
+    "rho": ("rho", "water_density"),
+    "yaw_radius": ("yaw_radius", "yaw_radius_m"),
+    "block_coefficient": ("block_coefficient", "C_b", "Cb", "CB"),
+    "approach_speed": ("approach_speed", "U0", "U_0", "approach_speed_m_s"),
+}
+"""Meta keys of a record (``# L: 7.0`` lines of its file) that state each particular
+(:func:`find_particulars`)."""
+
+DEFAULT_FROUDE_NUMBER = 0.15
+"""Approach Froude number ``U / sqrt(g L)`` of :meth:`VMMParams.from_particulars` when no
+approach speed is given (KVLCC2 model trials: 0.142)."""
+
+IMO_RUDDER_RATE = math.radians(65.0 / 28.0)
+"""IMO minimum rudder rate [rad/s] (35 deg to 30 deg the other side in 28 s, SOLAS II-1/29) of
+a :data:`IMO_RATE_LENGTH` ship: the default steering gear of
+:meth:`VMMParams.from_particulars`, Froude-scaled to the ship's length."""
+
+IMO_RATE_LENGTH = 320.0
+"""Length [m] at which :data:`IMO_RUDDER_RATE` is taken (a large tanker; a 7 m model of it
+then steers at 15.7 deg/s, as the KVLCC2 model does)."""
+
+_GRAVITY = 9.81
+
+
+def parse_particulars(text: str) -> dict[str, float]:
+    """The particulars of ``"length=7.0,breadth=1.27,draught=0.46,displacement=3.27,..."``.
+
+    Parameters
+    ----------
+    text : str
+        Comma-separated ``key=value`` pairs, keys of :data:`PARTICULARS` (SI units: m, m^3,
+        kg, kg/m^3, m/s); ``length, breadth, draught, x_g`` and ``displacement`` or ``mass``
+        are required.
+
+    Returns
+    -------
+    dict
+        Key -> value, for :meth:`VMMParams.from_particulars` (``**``).
+
+    Raises
+    ------
+    ValueError
+        For an entry that is not ``key=number``, an unknown or repeated key (naming the known
+        ones) or a missing particular (naming ``--particulars`` and the missing keys).
+    """
+    if not isinstance(text, str):
+        raise ValueError(f"particulars must be a text of key=value pairs, got {text!r}")
+    out: dict[str, float] = {}
+    for part in text.split(","):
+        if not part.strip():
+            continue
+        key, sep, value = part.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ValueError(
+                f"--particulars entry {part.strip()!r} is not key=value (e.g. 'length=7.0')"
+            )
+        if key not in PARTICULARS:
+            raise ValueError(
+                f"--particulars: unknown key {key!r}; known keys: {', '.join(PARTICULARS)}"
+            )
+        if key in out:
+            raise ValueError(f"--particulars: key {key!r} given twice")
+        try:
+            out[key] = float(value)
+        except ValueError:
+            raise ValueError(
+                f"--particulars: {key}={value.strip()!r} is not a number (SI units: "
+                f"{PARTICULARS[key]})"
+            ) from None
+    _require_particulars(out, "--particulars")
+    return out
+
+
+def _require_particulars(found: Mapping[str, Any], where: str) -> None:
+    """``ValueError`` naming ``where`` and the particulars missing from ``found``."""
+    missing = [k for k in _REQUIRED_PARTICULARS if k not in found]
+    if "displacement" not in found and "mass" not in found:
+        missing.append("displacement (or mass)")
+    if missing:
+        raise ValueError(
+            f"{where} misses the particular(s) {', '.join(missing)}; expected e.g. "
+            '--particulars "length=7.0,breadth=1.27,draught=0.46,displacement=3.27,x_g=0.25,'
+            'propeller_diameter=0.216" (SI units: m, m^3)'
+        )
+
+
+def find_particulars(meta: Mapping[str, Any]) -> dict[str, float]:
+    """The particulars a record's meta states (any spelling of :data:`PARTICULAR_SPELLINGS`).
+
+    Returns
+    -------
+    dict
+        Key of :data:`PARTICULARS` -> value, for the particulars found (possibly none).
+
+    Raises
+    ------
+    ValueError
+        For a value that is not a finite number, or two spellings of one particular with
+        different values.
+    """
+    out: dict[str, float] = {}
+    source: dict[str, str] = {}
+    for key, spellings in PARTICULAR_SPELLINGS.items():
+        for name in spellings:
+            value = meta.get(name)
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(
+                    f"meta {name!r} = {value!r} is not a number; expected the {PARTICULARS[key]}"
+                )
+            if key in out and out[key] != float(value):
+                raise ValueError(
+                    f"meta {source[key]!r} = {out[key]:g} and {name!r} = {value:g} state the "
+                    f"{PARTICULARS[key]} twice with different values"
+                )
+            out[key], source[key] = float(value), name
+    return out
+
+
+def _particular(value: Any, key: str, lo: float = 0.0, hi: float = math.inf) -> float:
+    """``value`` as a float in ``(lo, hi]``, else a ``ValueError`` naming ``key``."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ValueError(f"particular {key} must be a finite number, got {value!r}")
+    if not lo < value <= hi:
+        bound = f"in ({lo:g}, {hi:g}]" if math.isfinite(hi) else f"> {lo:g}"
+        raise ValueError(f"particular {key} must be {bound} ({PARTICULARS[key]}), got {value!r}")
+    return float(value)
 
 
 @dataclass(frozen=True, eq=False)
@@ -363,6 +527,122 @@ class VMMParams:
             raise ValueError(f"{str(p)!r} holds no VMM description (a JSON object)")
         return cls.from_dict(
             {k: v for k, v in data.items() if k not in ("current", "input_delay_s")}
+        )
+
+    @classmethod
+    def from_particulars(
+        cls,
+        *,
+        length: float,
+        breadth: float,
+        draught: float,
+        x_g: float,
+        displacement: float | None = None,
+        mass: float | None = None,
+        propeller_diameter: float | None = None,
+        rho: float = 1025.0,
+        yaw_radius: float | None = None,
+        block_coefficient: float | None = None,
+        approach_speed: float | None = None,
+        name: str = "ship",
+    ) -> VMMParams:
+        """The ship (no coefficients) from its main particulars, as a naval architect states
+        them.
+
+        ``mass = rho * displacement`` (or the displacement ``mass / rho``), the yaw inertia
+        about the centre of gravity ``I_z = mass * yaw_radius^2``, the added masses of Clarke,
+        Gedling and Hine (1982) (:func:`clarke_added_masses`) at the block coefficient
+        ``C_b = displacement / (L B T)`` unless given. Steering gear: the IMO minimum rate
+        (:data:`IMO_RUDDER_RATE`) Froude-scaled to ``length``, 35 deg maximum.
+
+        Parameters
+        ----------
+        length, breadth, draught : float
+            ``L``, ``B``, ``T`` [m], > 0 (``B`` and ``T`` less than ``L``).
+        x_g : float
+            Centre of gravity forward of midship [m], within the hull (``|x_g| < L / 2``).
+        displacement, mass : float
+            Displacement volume [m^3] or mass [kg]: exactly one of them, > 0.
+        propeller_diameter : float, optional
+            ``D`` [m], > 0; needed for records with propeller revolutions but no thrust.
+        rho : float
+            Water density [kg/m^3], in [950, 1100].
+        yaw_radius : float, optional
+            Yaw radius of gyration [m] in ``(0, L / 2]``; 0.25 L by default.
+        block_coefficient : float, optional
+            ``C_b`` in (0, 1]; ``displacement / (L B T)`` by default (which must be in (0, 1]).
+        approach_speed : float, optional
+            Trial speed [m/s] > 0 (the floor of the speed in the prime system and the start of
+            simulations); by default :data:`DEFAULT_FROUDE_NUMBER` ``* sqrt(g L)``: give the
+            measured one (``shipgym identify --particulars`` takes the runs' median speed).
+        name : str
+            The ship's name.
+
+        Raises
+        ------
+        ValueError
+            Naming the particular that is missing, not a finite number, or out of its range.
+        """
+        length = _particular(length, "length")
+        breadth = _particular(breadth, "breadth", hi=length)
+        draught = _particular(draught, "draught", hi=length)
+        rho = _particular(rho, "rho", 950.0, 1100.0)
+        if (displacement is None) == (mass is None):
+            raise ValueError(
+                "particulars need displacement (volume [m^3]) or mass [kg], exactly one of "
+                f"them; got displacement={displacement!r}, mass={mass!r}"
+            )
+        if mass is None:
+            volume = _particular(displacement, "displacement")
+            mass = rho * volume
+        else:
+            mass = _particular(mass, "mass")
+            volume = mass / rho
+        box = length * breadth * draught
+        if block_coefficient is None:
+            block_coefficient = volume / box
+            if not 0.0 < block_coefficient <= 1.0:
+                raise ValueError(
+                    f"particular displacement {volume:g} m^3 gives a block coefficient "
+                    f"displacement / (L B T) = {block_coefficient:.3g} for L B T = {box:g} m^3; "
+                    "expected it in (0, 1]: is the displacement a volume in m^3 (not tonnes or "
+                    "kg)?"
+                )
+        else:
+            block_coefficient = _particular(block_coefficient, "block_coefficient", hi=1.0)
+        half = 0.5 * length
+        if isinstance(x_g, bool) or not isinstance(x_g, int | float) or not abs(x_g) < half:
+            raise ValueError(
+                f"particular x_g must be a finite number within the hull, |x_g| < L/2 = "
+                f"{half:g} m ({PARTICULARS['x_g']}), got {x_g!r}"
+            )
+        yaw_radius = _particular(
+            0.25 * length if yaw_radius is None else yaw_radius, "yaw_radius", hi=half
+        )
+        diameter = (
+            0.0
+            if propeller_diameter is None
+            else _particular(propeller_diameter, "propeller_diameter", hi=breadth)
+        )
+        speed = (
+            DEFAULT_FROUDE_NUMBER * math.sqrt(_GRAVITY * length)
+            if approach_speed is None
+            else _particular(approach_speed, "approach_speed")
+        )
+        return cls(
+            coefficients={},
+            length=length,
+            breadth=breadth,
+            draught=draught,
+            mass=mass,
+            x_g=float(x_g),
+            yaw_inertia=mass * yaw_radius**2,
+            added=clarke_added_masses(length, breadth, draught, block_coefficient),
+            approach_speed=speed,
+            propeller_diameter=diameter,
+            rho=rho,
+            rudder_rate=IMO_RUDDER_RATE * math.sqrt(IMO_RATE_LENGTH / length),
+            name=str(name),
         )
 
     def approach_thrust(self) -> float:

@@ -1,6 +1,9 @@
 """System identification from measured manoeuvring data.
 
-* ``shipgym.sysid.data``: the canonical :class:`Record` and the loaders of the measured sources.
+* ``shipgym.sysid.record``: the canonical :class:`Record`, its CSV and the pipeline of arrays in
+  any units; ``shipgym.sysid.io``: the loaders, one module per source or kind of file, and
+  their registry (:func:`load`, :func:`detect_format`); ``shipgym.sysid.ingest``: the steps
+  every loader shares (unit checks, repairs); ``shipgym.sysid.data`` gathers their names.
 * ``shipgym.sysid.fit``: equation-error and output-error fits of the Nomoto-family models with
   standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
 * ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive

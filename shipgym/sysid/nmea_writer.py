@@ -2,7 +2,7 @@
 and of the worked example (:func:`write_nmea`).
 
 Each sentence type is written at its own rate with the talkers, noise, logger time stamps, bad
-checksums and dropouts asked for, in the forms :func:`shipgym.sysid.nmea.load_nmea` reads
+checksums and dropouts asked for, in the forms :func:`shipgym.sysid.io.nmea.load_nmea` reads
 (its module docstring lists the sentences and their conventions).
 """
 
@@ -19,16 +19,37 @@ import numpy.typing as npt
 import pynmeagps
 from pynmeagps import calc_checksum
 
-from shipgym.sysid.nmea import (
-    _DEFAULT_TALKERS,
-    _KNOT,
-    _NOISE_KEYS,
-    _WRITE_ORDER,
-    DEFAULT_RATES,
-    NMEA_LOGGER_STYLES,
-)
+from shipgym.sysid.io.nmea import NMEA_LOGGER_STYLES
+from shipgym.sysid.units import KNOT
 
-__all__ = ["write_nmea"]
+__all__ = ["DEFAULT_RATES", "write_nmea"]
+
+DEFAULT_RATES: Mapping[str, float] = {
+    "HDT": 10.0,
+    "ROT": 5.0,
+    "RSA": 5.0,
+    "RMC": 1.0,
+    "GGA": 1.0,
+    "VTG": 1.0,
+    "ZDA": 1.0,
+}
+"""Sentence rates [Hz] that :func:`write_nmea` uses when ``rates`` is not given."""
+
+_DEFAULT_TALKERS: Mapping[str, str] = {
+    "HDT": "HE",
+    "THS": "HE",
+    "HDG": "HC",
+    "ROT": "HE",
+    "RSA": "II",
+    "RMC": "GP",
+    "GGA": "GP",
+    "GLL": "GP",
+    "VTG": "GP",
+    "ZDA": "GP",
+}
+# order of the sentences of one instant in write_nmea: time-stamped sentences first
+_WRITE_ORDER = ("ZDA", "RMC", "GGA", "GLL", "VTG", "HDT", "THS", "HDG", "ROT", "RSA")
+_NOISE_KEYS = ("psi", "r", "delta", "U", "course", "xy")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -110,7 +131,7 @@ def _sentence(
         return f"{talker}ZDA,{hms},{when:%d,%m,%Y},00,00"
     kn = f"{v['sog']:.2f}" if "sog" in v else ""
     if kind == "VTG":
-        kmh = f"{v['sog'] * _KNOT * 3.6:.2f}" if "sog" in v else ""
+        kmh = f"{v['sog'] * KNOT * 3.6:.2f}" if "sog" in v else ""
         return f"{talker}VTG,{v['cog']:.2f},T,,M,{kn},N,{kmh},K,A"
     lat, lon = v["lat"], v["lon"]
     pos = f"{_dm(lat, 2)},{'N' if lat >= 0 else 'S'},{_dm(lon, 3)},{_ew(lon)}"
@@ -293,7 +314,7 @@ def write_nmea(
         if kind in ("RMC", "VTG"):
             values["cog"] = np.mod(np.degrees(sample("course", ts)), 360.0)
             if chan["U"] is not None:
-                values["sog"] = np.maximum(sample("U", ts), 0.0) / _KNOT
+                values["sog"] = np.maximum(sample("U", ts), 0.0) / KNOT
         if kind in ("RMC", "GGA", "GLL"):
             values["lat"] = lat0 + np.degrees(sample("x", ts, "xy") / m_rad)
             east = sample("y", ts, "xy") / (n_rad * math.cos(math.radians(lat0)))

@@ -439,14 +439,16 @@ def _windows(width, t, meas, rpm, az, starts, P, C, alpha0, v0, out):  # pragma:
                 out[i0, b, j] = x[j, b]
             out[i0, b, 4] += v0[b]
         for k in range(i0, i1 - 1):
-            # the orders over the step: the mean of its two samples (module docstring)
-            rpm_k = 0.5 * (rpm[k] + rpm[k + 1])
-            az_k = 0.5 * (az[k] + az[k + 1])
-            for b in range(width):
-                u[0, b], u[1, b] = pod_thrusts_col(rpm_k, x, C, P, b)
-                u[2, b] = az_k + alpha0[b]
-                u[3, b] = az_k + alpha0[b]
-            rk4_block(RVG3DOF, x, u, P, C, t[k + 1] - t[k], width, work)
+            # a step whose orders change is split at its midpoint, each half holding the order
+            # logged nearest to it (module docstring, "Replay")
+            halves = 2 if rpm[k + 1] != rpm[k] or az[k + 1] != az[k] else 1
+            h = (t[k + 1] - t[k]) / halves
+            for j in range(k, k + halves):
+                for b in range(width):
+                    u[0, b], u[1, b] = pod_thrusts_col(rpm[j], x, C, P, b)
+                    u[2, b] = az[j] + alpha0[b]
+                    u[3, b] = az[j] + alpha0[b]
+                rk4_block(RVG3DOF, x, u, P, C, h, width, work)
             for b in range(width):
                 for j in range(10):
                     out[k + 1, b, j] = x[j, b]

@@ -1,4 +1,4 @@
-"""NMEA 0183 logs of a ship's own sensors read into a canonical :class:`~shipgym.sysid.data.Record`.
+"""NMEA 0183 logs of a ship's own sensors read into a canonical record.
 
 :func:`load_nmea` reads a text log of NMEA 0183 sentences (one a line, optionally after a
 logger's time stamp or an NMEA 4.10 tag block), parses the sentences with ``pynmeagps``, puts a
@@ -88,13 +88,13 @@ kept grid point, except at the two ends of a segment: there up to its own ``max_
 points without it are trimmed (a 1 Hz fix ends up to 1 s before the 10 Hz heading). Otherwise it
 is dropped with a note giving its coverage; without the rate of turn, ``r`` is derived from the
 heading by :meth:`Record.from_arrays`. A log without rudder sentences is read with
-``delta = 0`` and a :class:`~shipgym.sysid.data.SysidDataWarning` and note saying there is no
+``delta = 0`` and a :class:`~shipgym.sysid.ingest.SysidDataWarning` and note saying there is no
 rudder sensor, so a model cannot be identified from it until the rudder is added.
 
 Checks and repairs
 ------------------
 A sentence with a wrong checksum (or a tag block with a wrong checksum) is dropped and counted:
-``meta["repairs"]`` lists the lines and a :class:`~shipgym.sysid.data.SysidDataWarning` is
+``meta["repairs"]`` lists the lines and a :class:`~shipgym.sysid.ingest.SysidDataWarning` is
 raised. Lines that are not NMEA sentences, sentences of a read type with an unreadable field and
 malformed checksum fields are dropped and reported the same way; nothing unreadable is used.
 Sentences without a checksum are kept (unverified) and counted in ``meta["notes"]``, as are
@@ -119,44 +119,21 @@ import numpy as np
 import pynmeagps
 from pynmeagps import NMEAReader, calc_checksum
 
-from shipgym.sysid.data import Record, SysidDataWarning
+from shipgym.sysid.ingest import SysidDataWarning, silent
+from shipgym.sysid.io.registry import SourceFormat
+from shipgym.sysid.record import Record
+from shipgym.sysid.units import KNOT
 
-__all__ = ["DEFAULT_RATES", "NMEA_LOGGER_STYLES", "load_nmea", "looks_like_nmea"]
-
-DEFAULT_RATES: Mapping[str, float] = {
-    "HDT": 10.0,
-    "ROT": 5.0,
-    "RSA": 5.0,
-    "RMC": 1.0,
-    "GGA": 1.0,
-    "VTG": 1.0,
-    "ZDA": 1.0,
-}
-"""Sentence rates [Hz] that :func:`write_nmea` uses when ``rates`` is not given."""
+__all__ = ["FORMAT", "NMEA_LOGGER_STYLES", "load_nmea", "looks_like_nmea"]
 
 NMEA_LOGGER_STYLES: tuple[str, ...] = ("iso", "bracket", "epoch", "tag")
-"""Logger time-stamp styles of :func:`write_nmea` (all read by :func:`load_nmea`)."""
+"""Logger time-stamp styles that :func:`load_nmea` reads (and
+:func:`shipgym.sysid.nmea_writer.write_nmea` writes)."""
 
-_KNOT = 1852.0 / 3600.0  # m/s per knot
 _KMH = 1.0 / 3.6  # m/s per km/h
 _DAY = 86400.0
 _READ = ("HDT", "THS", "HDG", "ROT", "RSA", "RMC", "GGA", "GLL", "VTG", "ZDA")
 _TIMED = frozenset({"RMC", "GGA", "GLL", "ZDA"})
-_DEFAULT_TALKERS: Mapping[str, str] = {
-    "HDT": "HE",
-    "THS": "HE",
-    "HDG": "HC",
-    "ROT": "HE",
-    "RSA": "II",
-    "RMC": "GP",
-    "GGA": "GP",
-    "GLL": "GP",
-    "VTG": "GP",
-    "ZDA": "GP",
-}
-# order of the sentences of one instant in write_nmea: time-stamped sentences first
-_WRITE_ORDER = ("ZDA", "RMC", "GGA", "GLL", "VTG", "HDT", "THS", "HDG", "ROT", "RSA")
-_NOISE_KEYS = ("psi", "r", "delta", "U", "course", "xy")
 _STYLE_NAMES = {
     "iso": "ISO 8601",
     "bracket": "bracketed ISO 8601",
@@ -178,10 +155,6 @@ _HEAD_PREFIX = re.compile(
     r"|\[?\d{9,13}(?:\.\d+)?\]?)?"  # Unix time
     r"[\s,;|]*(?:\\[^\\]*\\)?[$!][A-Z0-9]{4,6},"
 )
-
-
-def _silent(_msg: str) -> None:
-    """The progress printer that prints nothing."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -350,7 +323,7 @@ def _values(msgid: str, msg: Any, scan: _Scan) -> tuple[float, ...] | None:
         return (
             _num(get("lat")),
             _num(get("lon")),
-            _num(get("spd")) * _KNOT,
+            _num(get("spd")) * KNOT,
             _num(get("cog")),
             _signed(get("mv"), get("mvEW")),
         )
@@ -363,7 +336,7 @@ def _values(msgid: str, msg: Any, scan: _Scan) -> tuple[float, ...] | None:
     if msgid == "VTG":
         if get("posMode") == "N":
             return None
-        sog = _num(get("sogn")) * _KNOT if get("sognUnit") == "N" else math.nan
+        sog = _num(get("sogn")) * KNOT if get("sognUnit") == "N" else math.nan
         if not math.isfinite(sog) and get("sogkUnit") == "K":
             sog = _num(get("sogk")) * _KMH
         cog = _num(get("cogt")) if get("cogtUnit") == "T" else math.nan
@@ -996,12 +969,12 @@ def _optional(chans: _Channels, grid: _Grid, meta: dict[str, Any]) -> dict[str, 
 
 def load_nmea(
     path: Path,
-    say: Callable[[str], None] = _silent,
+    say: Callable[[str], None] = silent,
     *,
     dt: float | None = None,
     max_gap_s: float | None = None,
 ) -> Record:
-    """Read an NMEA 0183 log into a canonical :class:`~shipgym.sysid.data.Record`.
+    """Read an NMEA 0183 log into a canonical :class:`~shipgym.sysid.record.Record`.
 
     The sentences, conversions, the timing of every sentence, the uniform grid, the segments and
     the repairs are described in the module docstring.
@@ -1112,3 +1085,8 @@ def load_nmea(
         + (f" from {meta['start_time']}" if "start_time" in meta else "")
     )
     return Record.from_arrays(**arrays, meta=meta, max_gap_s=1.5 * grid.step)
+
+
+FORMAT = SourceFormat("nmea", load_nmea, looks_like_nmea, fallback=True, options=("max_gap_s",))
+"""The NMEA 0183 format of :func:`shipgym.sysid.io.load` (a fallback: after the formats with a
+header of their own, before any delimited table)."""

@@ -1,0 +1,111 @@
+"""HSVA KVLCC2 captive-free model tests (CPMC, SIMMAN 2008, ``hsva_kvlcc2``), model scale.
+
+Four header lines (cp1252) starting `` HSVA``, then 12 whitespace-separated columns
+(SOURCES.md). Conversions: deg -> rad; ``delta`` negated ("positive steering to port side");
+earth-fixed velocities rotated into body ``u``, ``v``; ``rpm = 60 n``; ``thrust`` [N] from
+column 11.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from shipgym.sysid.ingest import (
+    base_meta,
+    body_velocities,
+    check_units,
+    flag_irregular,
+    header_error,
+    measure_rudder_offset,
+    parse_table,
+    read_lines,
+    repair_heading,
+    repair_time,
+    report_empty_rows,
+    require_complete_rows,
+    silent,
+)
+from shipgym.sysid.io.registry import SourceFormat
+from shipgym.sysid.record import Record
+
+__all__ = ["FORMAT", "by_path", "load_hsva", "sniff"]
+
+
+def load_hsva(path: Path, say: Callable[[str], None] = silent) -> Record:
+    """Read one hsva file (module docstring); ``say`` takes progress lines."""
+    lines = read_lines(path, encoding="cp1252")
+    if "HSVA" not in lines[0]:
+        raise header_error(
+            path,
+            "hsva",
+            "4 header lines starting with ' HSVA' then 12 whitespace-separated columns",
+            lines[0],
+        )
+    meta = base_meta(
+        path,
+        "hsva",
+        vessel="KVLCC2, INSEAN model 2487 (HSVA CPMC, SIMMAN 2008)",
+        L=7.0,
+        scale="model",
+        title=lines[2].strip(),
+        frame="earth-fixed x0, y0 (y to starboard)",
+    )
+    data, n_empty = parse_table(lines[4:], None, 12, path, 5, say)
+    report_empty_rows(n_empty, meta)
+    require_complete_rows(data, range(11), meta)
+    t, data = repair_time(data[:, 0], data, meta)
+    deg = np.pi / 180.0
+    r = data[:, 6] * deg
+    delta = -data[:, 8] * deg
+    check_units(
+        t,
+        data[:, 3] * deg,
+        r,
+        delta,
+        meta,
+        names={"psi": "psi (column 4)", "r": "r (column 7)", "delta": "delta (column 9)"},
+    )
+    psi = repair_heading(t, data[:, 3] * deg, r, meta)
+    u, v = body_velocities(data[:, 4], data[:, 5], psi)
+    meta["conversions"] += [
+        "psi, r, delta deg -> rad",
+        "delta negated (report: positive = steering to port side)",
+        "earth-fixed dx0/dt, dy0/dt rotated into body u, v",
+        "rpm = 60 * n [rps]",
+        "thrust [N] from column 11 (total propeller thrust, model scale)",
+    ]
+    meta["r_source"] = "measured"
+    measure_rudder_offset(t, delta, meta)
+    flag_irregular(t, meta)
+    return Record(
+        time=t,
+        delta=delta,
+        psi=psi,
+        r=r,
+        x=data[:, 1],
+        y=data[:, 2],
+        u=u,
+        v=v,
+        U=np.hypot(data[:, 4], data[:, 5]),
+        rpm=60.0 * data[:, 9],
+        thrust=data[:, 10],
+        meta=meta,
+    )
+
+
+def sniff(head: str) -> bool:
+    """A first line holding ``HSVA``."""
+    first = head.splitlines()[0] if head.strip() else ""
+    return first.strip().startswith("HSVA")
+
+
+def by_path(path: Path) -> bool:
+    """``hsva_*`` files and the ``hsva_kvlcc2`` folder."""
+    return path.name.lower().startswith("hsva_") or path.parent.name.lower() == "hsva_kvlcc2"
+
+
+FORMAT = SourceFormat("hsva", load_hsva, sniff, by_path)
+"""The hsva format of :func:`shipgym.sysid.io.load`."""
