@@ -978,14 +978,16 @@ def _channel_sigma(rp: _Replay, runs: Sequence[int], fit: VMMFit) -> np.ndarray:
     return np.maximum(np.minimum(rms, spread), 1e-3 * np.maximum(spread, 1e-9))
 
 
-def actuator_bounds(name: str, lengths_s: float) -> tuple[float, float]:
-    """Bounds of the parameter of actuator cause ``name`` (the shared bounds, the time
-    constant and the delay capped at :data:`ACTUATOR_SEARCH_LENGTHS` ship lengths of travel
-    ``lengths_s`` [s] each)."""
+def actuator_bounds(name: str, rp: _Replay, length: float) -> tuple[float, float]:
+    """Bounds of the parameter of actuator cause ``name`` on the replays ``rp`` of a ship of
+    ``length`` [m]: the shared bounds, a time constant or delay at most
+    :data:`ACTUATOR_SEARCH_LENGTHS` ship lengths of travel and at least one replay step (a
+    shorter one is not resolved by the replay: a fit ending there did not find one)."""
     lo, hi = next(iter(CAUSES[name].bounds.values()))
     if name != "rudder_offset":
-        hi = min(hi, ACTUATOR_SEARCH_LENGTHS * lengths_s)
-        lo = min(lo, 0.01 * hi)
+        step = float(np.median(np.diff(rp.t[~rp.first])))
+        hi = min(hi, ACTUATOR_SEARCH_LENGTHS * _travel_s(rp, length))
+        lo = min(max(lo, step), 0.5 * hi)
     return lo, hi
 
 
@@ -1028,8 +1030,7 @@ def refine(fit: VMMFit, rp: _Replay, fit_runs: Sequence[int], max_nfev: int = 20
     )  # fmt: skip
     bounds = [(-math.inf, math.inf)] * len(free) + [VMM_EFFECTS["current"].bounds[k]
                                                    for k in extra]  # fmt: skip
-    travel = _travel_s(rp, fit.params.length)
-    bounds += [actuator_bounds(_ACTUATOR_OF[k], travel) for k in acts]
+    bounds += [actuator_bounds(_ACTUATOR_OF[k], rp, fit.params.length) for k in acts]
     lo, hi = (np.array(b, dtype=np.float64) for b in zip(*bounds, strict=True))
     theta0 = np.clip(theta0, lo, hi)
     n_free, n_cur = len(free), len(free) + len(extra)
@@ -1072,7 +1073,7 @@ def _flag_bound(cand: Candidate, name: str, rp: _Replay) -> Candidate:
     then does not accept it: the bound, not the records, chose the value)."""
     key = CAUSES[name].parameters[0]
     value = cand.fitted.actuators.get(key)
-    lo, hi = actuator_bounds(name, _travel_s(rp, cand.fitted.params.length))
+    lo, hi = actuator_bounds(name, rp, cand.fitted.params.length)
     if value is not None and min(value - lo, hi - value) <= 0.005 * (hi - lo):
         cand.extra["at_bound"] = f"{key} = {value:.4g} at a bound of ({lo:.4g}, {hi:.4g})"
     return cand
@@ -1083,7 +1084,7 @@ def search_actuator(rp: _Replay, runs: Sequence[int], fit: Any, name: str) -> di
     minimises the weighted replay error of ``runs`` with the rest of the model fixed (a
     bounded Brent search, each value one replay): the start of the joint refinement."""
     key = CAUSES[name].parameters[0]
-    lo, hi = actuator_bounds(name, _travel_s(rp, fit.params.length))
+    lo, hi = actuator_bounds(name, rp, fit.params.length)
 
     def cost(value: float) -> float:
         return _replay_cost(rp, runs, replace(fit, actuators=fit.actuators | {key: value}), fit)
@@ -1547,8 +1548,8 @@ class MMGFamily(VMMFamily):
         c0 = list(start.current) if start and "current" in start.effects else [0.0, 0.0]
         theta0 = np.array(f0 + c0[: len(extra)] + [act0[k] for k in acts])
         lo, hi = MMG_FACTOR_BOUNDS
-        travel = _travel_s(ctx.rp_fit, published.length)
-        act_bounds = [actuator_bounds(_ACTUATOR_OF[k], travel) for k in acts]
+        act_bounds = [actuator_bounds(_ACTUATOR_OF[k], ctx.rp_fit, published.length)
+                      for k in acts]  # fmt: skip
         bounds = (
             np.array([lo] * len(MMG_FREE) + [-2.0] * len(extra) + [b[0] for b in act_bounds]),
             np.array([hi] * len(MMG_FREE) + [2.0] * len(extra) + [b[1] for b in act_bounds]),
