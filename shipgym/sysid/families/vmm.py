@@ -39,7 +39,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -58,6 +59,7 @@ from shipgym.models.vmm import (
     TERM_SETS,
     VMMParams,
     clarke_added_masses,
+    find_particulars,
     pack_vmm,
     propeller_loading,
     term_monomials,
@@ -73,6 +75,7 @@ from shipgym.sysid.families.base import (
     bic,
     causes,
     register,
+    undetermined,
     window_starts,
     wrap,
 )
@@ -246,8 +249,6 @@ def vessel_params(record: Record) -> VMMParams:
         the missing ones and the ``--particulars`` flag (``particulars=`` of
         :func:`~shipgym.sysid.engine.identify` and :class:`VMMFamily`).
     """
-    from shipgym.models.vmm import find_particulars
-
     meta = record.meta
     source = meta.get("source")
     if isinstance(meta.get("particulars"), dict):  # a record that states its ship
@@ -785,8 +786,6 @@ def actuator_document(params: VMMParams | MMGParams, actuators: Mapping[str, flo
     takes them: ``rudder_offset`` (the zero error on the rudder order), a steering gear of
     time constant ``T_d`` (``rudder_time_constant``, ``direct_rudder`` false) and the delay
     ``input_delay_s`` of :class:`~shipgym.models.ShipModel`."""
-    from dataclasses import asdict
-
     doc = params.to_dict() if isinstance(params, VMMParams) else asdict(params)
     if "delta0" in actuators:
         doc["rudder_offset"] = actuators["delta0"]
@@ -1428,8 +1427,6 @@ class VMMFamily(ModelFamily):
         equation whose regression is ill-conditioned (:attr:`CONDITION_LIMIT`); an accepted
         effect all of whose parameters with a standard error have one larger than the
         estimate."""
-        from shipgym.sysid.families.base import undetermined  # (kept beside its one use)
-
         fit = report["final"]
         out = super().verdict(ctx, report)
         reg = fit.regression
@@ -1605,8 +1602,6 @@ class MMGFamily(VMMFamily):
         (:data:`MMG_FREE`, which set the course stability): a factor on the published value
         whose standard error is larger than the factor, or one at :data:`MMG_FACTOR_BOUNDS`
         (the bound, not the records, set it)."""
-        from shipgym.sysid.families.base import undetermined  # (kept beside its one use)
-
         fit: MMGFit = report["final"]
         out = ModelFamily.verdict(self, ctx, report)
         out += [f"factor on {r}" for r in undetermined(fit.factors, fit.stderr, MMG_FREE)]
@@ -1641,8 +1636,6 @@ class VMMAutoFamily(VMMFamily):
         self.name = "vmm:auto"
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
-        from concurrent.futures import ThreadPoolExecutor
-
         def base(term_set: str) -> Candidate | Exception:
             try:
                 return self._candidate(replace(ctx, term_set=term_set), ())
