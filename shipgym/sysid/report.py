@@ -96,8 +96,11 @@ BENCH_GOALS: dict[str, float] = {
 10 000-sample record, the Gunnerus record with ``rvg3dof``, and the 3-DOF model on all 13 HSVA
 KVLCC2 runs together (the inverse-dynamics regression, and the whole loop)."""
 
-BENCH_VMM = "vmm:martin_simple"
-"""The 3-DOF model the HSVA benchmark identifies."""
+BENCH_VMM = "vmm:auto"
+"""The 3-DOF model the HSVA benchmark identifies (the term set chosen by the loop)."""
+
+BENCH_VMM_TERMS = "martin_simple"
+"""The term set of the HSVA regression benchmark."""
 
 _SOURCE_ORDER = ("sspa", "marin", "hsva", "esso_osaka", "usv", "gunnerus")
 _SOURCE_LABEL = {
@@ -987,9 +990,10 @@ def benchmark_sysid(
     * ``gunnerus``: ``identify(record, "rvg3dof")`` on the Gunnerus sea trials under ``root``;
       one run (skipped with a reason when ``root`` is None, the file is missing or
       :mod:`shipgym.sysid.families.rvg` is not registered);
-    * ``hsva_regression``, ``hsva_loop`` (``kvlcc2``): the 3-DOF :data:`BENCH_VMM` on the 13
-      HSVA KVLCC2 runs under ``root`` together: the inverse-dynamics regression (loading and
-      filtering included; median of ``repeats``) and the whole identification loop (one run);
+    * ``hsva_regression``, ``hsva_loop`` (``kvlcc2``): the 13 HSVA KVLCC2 runs under ``root``
+      together: the inverse-dynamics regression of :data:`BENCH_VMM_TERMS` (loading and
+      filtering included; median of ``repeats``) and the whole identification loop of
+      :data:`BENCH_VMM`, the term set chosen by the loop (one run);
     * ``replays`` (a list beside ``results``, no goal): one finite-difference Jacobian's replays
       one at a time and side by side, in at least 5 interleaved rounds, and the median of the
       same-round speed-ups (:func:`_bench_replays`).
@@ -1109,7 +1113,7 @@ def benchmark_sysid(
     # 4. the 3-DOF model on the 13 HSVA runs together
     folder = None if root is None else Path(root) / "hsva_kvlcc2"
     descs = {
-        "hsva_regression": f"{BENCH_VMM} regression, 13 HSVA KVLCC2 runs",
+        "hsva_regression": f"vmm:{BENCH_VMM_TERMS} regression, 13 HSVA KVLCC2 runs",
         "hsva_loop": f"identify loop, {BENCH_VMM}, 13 HSVA KVLCC2 runs",
     }
     if not kvlcc2:
@@ -1155,7 +1159,7 @@ def _bench_hsva(
         hsva = [load(p, "hsva") for p in sorted(folder.glob("*.dat"))]
     n = sum(r.n for r in hsva)
     template = fv.vessel_params(hsva[0])
-    terms = TERM_SETS[BENCH_VMM.removeprefix("vmm:")]
+    terms = TERM_SETS[BENCH_VMM_TERMS]
     say("hsva: warm-up on two runs ...")
     identify(hsva[:2], BENCH_VMM, max_effects=0)
     reg_times, _ = _median_time(
