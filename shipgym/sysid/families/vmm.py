@@ -163,6 +163,10 @@ VMM_EFFECTS: dict[str, Effect] = {
 """The effects of the VMM family (module docstring): the shared causes
 (:data:`~shipgym.sysid.families.base.CAUSES`) and the hull's own terms."""
 
+PROFILE_POINTS = 9
+"""Grid of an actuator cause's parameter in the regression profile
+(:meth:`VMMFamily._profile_actuator`)."""
+
 ACTUATOR_SEARCH_LENGTHS = 3.0
 """Largest steering-gear time constant and input delay searched, in ship lengths of travel
 (``3 L / U``: 18 s on the 7 m KVLCC2 model; the shared bounds cap it at full scale)."""
@@ -839,10 +843,12 @@ def fit_vmm(
     fit_runs: Sequence[int] | None = None,
     refine_fit: bool = True,
     actuators: Mapping[str, float] | None = None,
+    stderr: bool = True,
 ) -> VMMFit:
     """Regression, then (with ``rp``) output-error refinement on the runs ``fit_runs``; the
     regression sees the rudder felt under ``actuators`` (:func:`felt_rudder`), which the
-    refinement refines with the coefficients."""
+    refinement refines with the coefficients; ``stderr=False`` skips the regression's standard
+    errors (a search that only needs its residual)."""
     terms = loop_terms(term_set, effects)
     act = dict(actuators or {})
     chosen = [runs[i] for i in (fit_runs if fit_runs is not None else range(len(runs)))]
@@ -850,7 +856,7 @@ def fit_vmm(
         gear = _gear_of(template)
         chosen = [replace(r, delta=felt_rudder(r.t, r.delta, act, gear)) for r in chosen]
     cur = _current_fit(chosen, template, terms) if "current" in effects else (0.0, 0.0)
-    reg = regress(chosen, template, terms, current=cur)
+    reg = regress(chosen, template, terms, current=cur, stderr=stderr)
     params = template.with_coefficients(reg.coefficients)
     name = term_set if isinstance(term_set, str) else ""
     fit = VMMFit(params, cur, tuple(effects), reg, False, dict(reg.stderr), act, name)
@@ -1287,15 +1293,14 @@ class VMMFamily(ModelFamily):
         refinement costs 20-50 times the regression).
 
         An actuator cause (rudder offset, steering-gear lag, input delay) changes the rudder
-        every term sees: its parameter starts where the replay of the current model fits the
-        training runs best (:func:`search_actuator`), the regression is made again on the
-        rudder so felt, and the refinement estimates the parameter with the coefficients; it
-        is never screened out (the regression's derivatives smooth a rudder's timing away)."""
+        every term sees: its parameter starts where the regression on the rudder so felt
+        explains the training runs' forces best (:meth:`_profile_actuator`), and the refinement
+        estimates it with the coefficients; it is never screened out."""
         if name == "wind" and not all(r.has_wind for r in ctx.runs):
             raise ValueError("the records have no wind channels")
         effects = (*current.effects, name)
         if name in ACTUATOR_CAUSES:
-            act = search_actuator(ctx.rp_fit, ctx.train, current.fitted, name)
+            act = self._profile_actuator(ctx, current, name)
             screen = self._score(ctx, self._fit(ctx, effects, ctx.train, False, act))
             return _flag_bound(self._candidate(ctx, effects, screen), name, ctx.rp_fit)
         fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
@@ -1307,6 +1312,30 @@ class VMMFamily(ModelFamily):
         cand = self._candidate(ctx, effects, self._score(ctx, fit))
         cand.extra["screen_equation_error_drop"] = drop
         return cand
+
+    def _profile_actuator(self, ctx: _Context, current: Candidate, name: str) -> dict[str, float]:
+        """The current model's actuator parameters with that of cause ``name`` added where the
+        regression, its coefficients estimated again at each value, leaves the least equation
+        error on the training runs: a grid of :data:`PROFILE_POINTS` values over
+        :func:`actuator_bounds`, then a bounded Brent search around the best (the value the
+        hull's coefficients, fitted with the recorded rudder, would have compensated for is
+        not a start a search with them fixed can leave)."""
+        key = CAUSES[name].parameters[0]
+        lo, hi = actuator_bounds(name, ctx.rp_fit, ctx.template.length)
+        effects = (*current.effects, name)
+
+        def cost(value: float) -> float:
+            act = current.fitted.actuators | {key: float(value)}
+            return _equation_error(fit_vmm(ctx.runs, ctx.template, ctx.term_set, effects,
+                                           fit_runs=ctx.train, refine_fit=False, actuators=act,
+                                           stderr=False))  # fmt: skip
+
+        grid = np.linspace(lo, hi, PROFILE_POINTS)
+        k = int(np.argmin([cost(v) for v in grid]))
+        bracket = (grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)])
+        sol = minimize_scalar(cost, bounds=bracket, method="bounded",
+                              options={"xatol": 1e-3 * (hi - lo), "maxiter": 20})  # fmt: skip
+        return current.fitted.actuators | {key: float(sol.x)}
 
     def effect_parameters(self, fitted: VMMFit, name: str) -> dict[str, float]:
         vals = fitted.values
