@@ -18,8 +18,8 @@ Pods (eq. 18-20): first-order thrust and azimuth, ``T' = (sat(T_c) - T) / tau_T`
 ``alpha' = sat_rate((sat(alpha_c) + alpha_0 - alpha) / tau_alpha)`` (``alpha_0``: an identified
 azimuth offset, 0 in seed 001). The azimuth order ``alpha_c`` is what a record logs; the pods
 follow it through this servo, whose time constant ``tau_alpha`` the source calls "a pure guess"
-(1 s): the identification's ``rudder_lag`` effect fits it, within
-:data:`AZIMUTH_TIME_CONSTANT_RANGE`, the shared steering-gear cause on the pods. Each pod at ``(x_t, y_t)`` gives
+(1 s): the identification's ``rudder_lag`` effect (the shared steering-gear cause on the pods)
+fits it within :data:`AZIMUTH_TIME_CONSTANT_RANGE`. Each pod at ``(x_t, y_t)`` gives
 ``F = T [cos a, sin a, -y_t cos a + x_t sin a]``, so positive azimuth on aft pods turns the ship
 to port. Thrust is limited to ``[0, T_bollard (1 - u_r / u_0)]``, a fit to the Kongsberg pod at
 200 rpm (RVG_PARAMETERS.md).
