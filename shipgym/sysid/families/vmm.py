@@ -1641,24 +1641,12 @@ class MMGFamily(VMMFamily):
         return out
 
 
-SELECTION_TIE = 0.05
-"""Term sets whose held-out error is within this fraction of the lowest are tied for
-``vmm:auto``; the one with the fewest terms wins (the loop's parsimony among near-ties)."""
-
-
 def describe_selection(selection: Mapping[str, Any]) -> str:
     """One line on ``vmm:auto``'s choice (``term_set_selection`` of its diagnostics)."""
     best, runner = selection["chosen"], selection["runner_up"]
     scores = selection["heldout_error"]
-    if not runner:
-        return f"{best} (the only term set fitted)"
-    change = 100 * (scores[best] / scores[runner] - 1)
-    if len(selection.get("tied", ())) > 1:
-        return (
-            f"{best} (the fewest terms of the sets within {100 * SELECTION_TIE:.0f} % of the "
-            f"lowest held-out error; {change:+.0f} % against {runner})"
-        )
-    return f"{best} (the lowest held-out error of the term sets, {-change:.0f} % below {runner})"
+    margin = f", {100 * (1 - scores[best] / scores[runner]):.0f} % below {runner}" if runner else ""
+    return f"{best} (the lowest held-out error of the term sets{margin})"
 
 
 class VMMAutoFamily(VMMFamily):
@@ -1667,9 +1655,9 @@ class VMMAutoFamily(VMMFamily):
     Every term set of :data:`~shipgym.models.vmm.TERM_SETS` is fitted as a base model on the
     training runs (regression and refinement, two at a time) and scored on the held-out runs,
     the same cross-validation across runs that then judges the effects; the set with the lowest
-    held-out error (the geometric mean of the ``psi, r, u, v`` RMS) wins, the one with the
-    fewest terms among those within :data:`SELECTION_TIE` of it, and the loop goes on with it.
-    The scores of every set are said and kept in the diagnostics (``term_set_selection``).
+    held-out error (the geometric mean of the ``psi, r, u, v`` RMS) wins, and the loop goes on
+    with it. The scores of every set are said and kept in the diagnostics
+    (``term_set_selection``).
     """
 
     def __init__(self) -> None:
@@ -1695,14 +1683,11 @@ class VMMAutoFamily(VMMFamily):
         for n in set(names) - set(fitted):
             say(f"  term set {n}: failed ({outcomes[n]})")
         scores = {n: fitted[n].heldout_error for n in ranked}
-        tied = [n for n in ranked if scores[n] <= (1.0 + SELECTION_TIE) * scores[ranked[0]]]
-        best = min(tied, key=lambda n: (len(loop_terms(n, ())), scores[n]))
-        runner_up = next((n for n in ranked if n != best and math.isfinite(scores[n])), None)
-        ctx.term_set = best
-        ctx.selection = {"chosen": best, "heldout_error": scores, "runner_up": runner_up,
-                         "tied": tied}  # fmt: skip
+        runner_up = next((n for n in ranked[1:] if math.isfinite(scores[n])), None)
+        ctx.term_set = ranked[0]
+        ctx.selection = {"chosen": ranked[0], "heldout_error": scores, "runner_up": runner_up}
         say(f"term set {describe_selection(ctx.selection)}")
-        return fitted[best]
+        return fitted[ranked[0]]
 
     def finish(
         self, ctx: _Context, base: Candidate, final: Candidate, say: Callable[[str], None]
