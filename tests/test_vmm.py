@@ -365,6 +365,23 @@ def test_on_records_of_the_mmg_model_a_rudder_zero_error_is_named() -> None:
     assert held["error_after"]["psi_rms_deg"] < 0.5 * held["error_before"]["psi_rms_deg"]
 
 
+def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
+    """``vmm:auto`` fits every term set, keeps the one that predicts the held-out run best,
+    says which and by how much, and goes on with it."""
+    from shipgym.sysid.families.vmm import loop_terms
+
+    runs = generate_vmm_runs(None, n_runs=3, seed=4, dt=0.5)
+    said: list[str] = []
+    result = identify(runs, "vmm:auto", max_effects=0, progress=said.append)
+    sel = result.diagnostics["term_set_selection"]
+    scores = sel["heldout_error"]
+    assert set(scores) == set(TERM_SETS)
+    assert sel["chosen"] == min(scores, key=scores.__getitem__)
+    assert set(result.parameters_after) == set(loop_terms(sel["chosen"], ()))
+    assert any(line.startswith(f"term set {sel['chosen']} (") for line in said)
+    assert result.to_dict()["term_set_selection"]["chosen"] == sel["chosen"]
+
+
 def test_single_run_families_refuse_several_records(wind_runs) -> None:
     with pytest.raises(ValueError, match="one record at a time"):
         identify(wind_runs[:2], "nomoto1")
