@@ -163,7 +163,7 @@ VMM_EFFECTS: dict[str, Effect] = {
 """The effects of the VMM family (module docstring): the shared causes
 (:data:`~shipgym.sysid.families.base.CAUSES`) and the hull's own terms."""
 
-PROFILE_POINTS = 9
+PROFILE_POINTS = 7
 """Grid of an actuator cause's parameter in the regression profile
 (:meth:`VMMFamily._profile_actuator`)."""
 
@@ -1319,7 +1319,8 @@ class VMMFamily(ModelFamily):
         error on the training runs: a grid of :data:`PROFILE_POINTS` values over
         :func:`actuator_bounds`, then a bounded Brent search around the best (the value the
         hull's coefficients, fitted with the recorded rudder, would have compensated for is
-        not a start a search with them fixed can leave)."""
+        not a start a search with them fixed can leave). To 1 % of the range: the refinement
+        then estimates it with the coefficients."""
         key = CAUSES[name].parameters[0]
         lo, hi = actuator_bounds(name, ctx.rp_fit, ctx.template.length)
         effects = (*current.effects, name)
@@ -1334,7 +1335,7 @@ class VMMFamily(ModelFamily):
         k = int(np.argmin([cost(v) for v in grid]))
         bracket = (grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)])
         sol = minimize_scalar(cost, bounds=bracket, method="bounded",
-                              options={"xatol": 1e-3 * (hi - lo), "maxiter": 20})  # fmt: skip
+                              options={"xatol": 0.01 * (hi - lo), "maxiter": 10})  # fmt: skip
         return current.fitted.actuators | {key: float(sol.x)}
 
     def effect_parameters(self, fitted: VMMFit, name: str) -> dict[str, float]:
