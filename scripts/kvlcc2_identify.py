@@ -7,7 +7,9 @@ Usage::
 
 1. **HSVA, cross-validation across runs.** For every term set and every one of the 13 HSVA
    zigzags, the VMM is fitted on the other 12 runs (inverse-dynamics regression, then the
-   output-error refinement of :mod:`shipgym.sysid.families.vmm`) and predicts the left-out run
+   output-error refinement of :mod:`shipgym.sysid.families.vmm`) with the term set's
+   straight-running side force (the ``asymmetry`` effect, as the Nomoto model below has its
+   rudder offset) and predicts the left-out run
    in windows of 15 ship lengths (89 s), each window's initial sway and yaw rate estimated from
    that window with the coefficients fixed. The first-order Nomoto model gets the same protocol
    (K, T and a rudder offset fitted jointly on the other runs through the package's Nomoto
@@ -58,6 +60,9 @@ from shipgym.sysid.report import update_readme, write_json
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from kvlcc2_simman import _trial
 
+VMM_EFFECTS = ("asymmetry",)
+"""The effects of the fitted VMM: the straight-running side force of the single screw."""
+
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_ROOT = (REPO / ".." / "shared" / "data" / "measured").resolve()
 TERM_SETS = ("linear", "martin_simple", "martin", "norrbin3")
@@ -99,7 +104,7 @@ def _vmm_fold(task: tuple[str, str, int, str, str, float | None]) -> dict[str, A
     records = _records(Path(root), folder, pattern)
     template, runs, score, shoot = _setup(records, window_s)
     train = [i for i in range(len(runs)) if i != left]
-    fit = fv.fit_vmm(runs, template, term_set, (), rp=shoot, fit_runs=train)
+    fit = fv.fit_vmm(runs, template, term_set, VMM_EFFECTS, rp=shoot, fit_runs=train)
     sim = fv.predict(fit, score, [left])
     m = score.run_mask([left])
     return {"term_set": term_set, "run": runs[left].name, "refined": fit.refined,
@@ -227,7 +232,7 @@ def _trials_of(
 
 def _fit_all(records: list[Any], term_set: str) -> Any:
     template, runs, _, shoot = _setup(records, None)
-    return fv.fit_vmm(runs, template, term_set, (), rp=shoot)
+    return fv.fit_vmm(runs, template, term_set, VMM_EFFECTS, rp=shoot)
 
 
 # ------------------------------------------------------------------------------------------
