@@ -986,13 +986,13 @@ def _channel_sigma(rp: _Replay, runs: Sequence[int], fit: VMMFit) -> np.ndarray:
 def actuator_bounds(name: str, rp: _Replay, length: float) -> tuple[float, float]:
     """Bounds of the parameter of actuator cause ``name`` on the replays ``rp`` of a ship of
     ``length`` [m]: the shared bounds, a time constant or delay at most
-    :data:`ACTUATOR_SEARCH_LENGTHS` ship lengths of travel and at least one replay step (a
-    shorter one is not resolved by the replay: a fit ending there did not find one)."""
+    :data:`ACTUATOR_SEARCH_LENGTHS` ship lengths of travel and at least the records' sample
+    interval (a shorter one is not resolved by the record: a fit ending there found none)."""
     lo, hi = next(iter(CAUSES[name].bounds.values()))
     if name != "rudder_offset":
-        step = float(np.median(np.diff(rp.t[~rp.first])))
+        dt = min(float(np.median(np.diff(t))) for t, _, _ in rp.sources)
         hi = min(hi, ACTUATOR_SEARCH_LENGTHS * _travel_s(rp, length))
-        lo = min(max(lo, step), 0.5 * hi)
+        lo = min(max(lo, dt), 0.5 * hi)
     return lo, hi
 
 
