@@ -691,6 +691,58 @@ def body_velocities(
     return dx * c + dy * s, -dx * s + dy * c
 
 
+def tank_channels(
+    t: np.ndarray,
+    data: np.ndarray,
+    meta: dict[str, Any],
+    columns: Mapping[str, int],
+    rudder_sign: str,
+) -> dict[str, np.ndarray]:
+    """The motion channels of a tank record in degrees with earth-fixed positions and
+    velocities (the SIMMAN 2008 HSVA and MARIN files): heading, yaw rate and a port-positive
+    rudder in degrees are converted, unit-checked (:func:`check_units`), the heading repaired
+    (:func:`repair_heading`), the rudder negated to the project's convention and its neutral
+    offset measured (:func:`measure_rudder_offset`), the velocities ``dx0/dt, dy0/dt`` rotated
+    into body ``u, v`` and the time step checked (:func:`flag_irregular`); the conversions go
+    to ``meta``.
+
+    Parameters
+    ----------
+    t, data : numpy.ndarray
+        Sample times [s] and the table's columns.
+    meta : dict
+        The record's meta (updated).
+    columns : mapping
+        Column of ``x``, ``y``, ``psi``, ``dx``, ``dy``, ``r`` and ``delta`` in ``data``.
+    rudder_sign : str
+        The source's words for its rudder sign (kept in the conversions).
+
+    Returns
+    -------
+    dict
+        ``time, delta, psi, r, x, y, u, v, U`` for :class:`~shipgym.sysid.record.Record`.
+    """
+    c = columns
+    deg = math.pi / 180.0
+    r = data[:, c["r"]] * deg
+    delta = -data[:, c["delta"]] * deg
+    names = {k: f"{k} (column {c[k] + 1})" for k in ("psi", "r", "delta")}
+    check_units(t, data[:, c["psi"]] * deg, r, delta, meta, names=names)
+    psi = repair_heading(t, data[:, c["psi"]] * deg, r, meta)
+    dx, dy = data[:, c["dx"]], data[:, c["dy"]]
+    u, v = body_velocities(dx, dy, psi)
+    meta["conversions"] += [
+        "psi, r, delta deg -> rad",
+        f"delta negated ({rudder_sign})",
+        "earth-fixed dx0/dt, dy0/dt rotated into body u, v",
+    ]
+    meta["r_source"] = "measured"
+    measure_rudder_offset(t, delta, meta)
+    flag_irregular(t, meta)
+    return {"time": t, "delta": delta, "psi": psi, "r": r, "x": data[:, c["x"]],
+            "y": data[:, c["y"]], "u": u, "v": v, "U": np.hypot(dx, dy)}  # fmt: skip
+
+
 def base_meta(path: Path, source: str, **kw: Any) -> dict[str, Any]:
     """The meta every loader starts from: ``source``, ``file``, ``vessel``, ``L``, ``scale`` and
     empty ``conversions``, ``repairs``, ``notes`` (``kw`` added or overriding)."""

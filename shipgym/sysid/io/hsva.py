@@ -11,22 +11,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
-
 from shipgym.sysid.ingest import (
     base_meta,
-    body_velocities,
-    check_units,
-    flag_irregular,
     header_error,
-    measure_rudder_offset,
     parse_table,
     read_lines,
-    repair_heading,
     repair_time,
     report_empty_rows,
     require_complete_rows,
     silent,
+    tank_channels,
 )
 from shipgym.sysid.io.registry import SourceFormat
 from shipgym.sysid.record import Record
@@ -57,44 +51,15 @@ def load_hsva(path: Path, say: Callable[[str], None] = silent) -> Record:
     report_empty_rows(n_empty, meta)
     require_complete_rows(data, range(11), meta)
     t, data = repair_time(data[:, 0], data, meta)
-    deg = np.pi / 180.0
-    r = data[:, 6] * deg
-    delta = -data[:, 8] * deg
-    check_units(
-        t,
-        data[:, 3] * deg,
-        r,
-        delta,
-        meta,
-        names={"psi": "psi (column 4)", "r": "r (column 7)", "delta": "delta (column 9)"},
-    )
-    psi = repair_heading(t, data[:, 3] * deg, r, meta)
-    u, v = body_velocities(data[:, 4], data[:, 5], psi)
+    channels = tank_channels(
+        t, data, meta, {"x": 1, "y": 2, "psi": 3, "dx": 4, "dy": 5, "r": 6, "delta": 8},
+        "report: positive = steering to port side",
+    )  # fmt: skip
     meta["conversions"] += [
-        "psi, r, delta deg -> rad",
-        "delta negated (report: positive = steering to port side)",
-        "earth-fixed dx0/dt, dy0/dt rotated into body u, v",
         "rpm = 60 * n [rps]",
         "thrust [N] from column 11 (total propeller thrust, model scale)",
     ]
-    meta["r_source"] = "measured"
-    measure_rudder_offset(t, delta, meta)
-    flag_irregular(t, meta)
-    return Record(
-        time=t,
-        delta=delta,
-        psi=psi,
-        r=r,
-        x=data[:, 1],
-        y=data[:, 2],
-        u=u,
-        v=v,
-        U=np.hypot(data[:, 4], data[:, 5]),
-        rpm=60.0 * data[:, 9],
-        thrust=data[:, 10],
-        meta=meta,
-    )
-
+    return Record(**channels, rpm=60.0 * data[:, 9], thrust=data[:, 10], meta=meta)
 
 def sniff(head: str) -> bool:
     """A first line holding ``HSVA``."""

@@ -12,22 +12,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
-
 from shipgym.sysid.ingest import (
     base_meta,
-    body_velocities,
-    check_units,
-    flag_irregular,
     header_error,
-    measure_rudder_offset,
     parse_table,
     read_lines,
-    repair_heading,
     repair_time,
     report_empty_rows,
     require_complete_rows,
     silent,
+    tank_channels,
 )
 from shipgym.sysid.io.registry import SourceFormat
 from shipgym.sysid.record import Record
@@ -63,46 +57,16 @@ def load_marin(path: Path, say: Callable[[str], None] = silent) -> Record:
     report_empty_rows(n_empty, meta)
     require_complete_rows(data, range(11), meta)
     t, data = repair_time(data[:, 0], data, meta, known_dt=_MARIN_DT)
-    deg = np.pi / 180.0
-    r = data[:, 8] * deg
-    delta = -data[:, 9] * deg
-    check_units(
-        t,
-        data[:, 4] * deg,
-        r,
-        delta,
-        meta,
-        names={"psi": "psi (column 5)", "r": "r (column 9)", "delta": "delta (column 10)"},
-    )
-    psi = repair_heading(t, data[:, 4] * deg, r, meta)
-    u, v = body_velocities(data[:, 5], data[:, 6], psi)
-    meta["conversions"] += [
-        "psi, r, delta deg -> rad",
-        "delta negated (source: positive rudder gives a port turn)",
-        "earth-fixed dx0/dt, dy0/dt rotated into body u, v",
-    ]
-    meta["r_source"] = "measured"
     meta["notes"] += [
         "all values have 3 significant digits (psi resolution 1 deg above 100 deg, x0 10 m above"
         " 1000 m)",
         "full scale; model scale: time and speeds / sqrt(45.714), lengths / 45.714",
     ]
-    measure_rudder_offset(t, delta, meta)
-    flag_irregular(t, meta)
-    return Record(
-        time=t,
-        delta=delta,
-        psi=psi,
-        r=r,
-        x=data[:, 1],
-        y=data[:, 2],
-        u=u,
-        v=v,
-        U=np.hypot(data[:, 5], data[:, 6]),
-        rpm=data[:, 10],
-        meta=meta,
-    )
-
+    channels = tank_channels(
+        t, data, meta, {"x": 1, "y": 2, "psi": 4, "dx": 5, "dy": 6, "r": 8, "delta": 9},
+        "source: positive rudder gives a port turn",
+    )  # fmt: skip
+    return Record(**channels, rpm=data[:, 10], meta=meta)
 
 def sniff(head: str) -> bool:
     """A first line starting ``MARIN``."""
