@@ -813,6 +813,38 @@ def require_columns(path: Path, fmt: str, cols: list[str], needed: Sequence[str]
     return {c: cols.index(c) for c in cols}
 
 
+def read_columns(
+    path: Path,
+    fmt: str,
+    lines: list[str],
+    sep: str,
+    needed: Sequence[str],
+    time_column: str,
+    meta: dict[str, Any],
+    say: Callable[[str], None],
+    optional: Sequence[str] = (),
+) -> tuple[np.ndarray, np.ndarray, dict[str, int]]:
+    """The rows of a delimited file with a one-line header of column names: the ``needed``
+    columns located (:func:`require_columns`), the rows parsed (:func:`parse_table`), rows
+    incomplete in the ``needed`` columns, and in the ``optional`` ones when every one of them
+    is present, dropped, and the time column repaired (:func:`repair_time`); what was done goes
+    to ``meta``.
+
+    Returns
+    -------
+    t, data, ix : numpy.ndarray, numpy.ndarray, dict
+        Sample times [s], the rows that remain and column name -> index.
+    """
+    cols = split_header(lines[0], sep)
+    ix = require_columns(path, fmt, cols, needed)
+    data, n_empty = parse_table(lines[1:], sep, len(cols), path, 2, say)
+    report_empty_rows(n_empty, meta)
+    used = [*needed, *(optional if all(c in ix for c in optional) else ())]
+    require_complete_rows(data, [ix[c] for c in used], meta)
+    t, data = repair_time(data[:, ix[time_column]], data, meta)
+    return t, data, ix
+
+
 # ----------------------------------------------------------------------------------------------
 # per-source loaders
 def latlon_to_ne(lat_deg: np.ndarray, lon_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

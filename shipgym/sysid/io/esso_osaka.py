@@ -21,15 +21,10 @@ from shipgym.sysid.ingest import (
     base_meta,
     check_units,
     flag_irregular,
-    parse_table,
+    read_columns,
     read_lines,
     repair_heading,
-    repair_time,
-    report_empty_rows,
-    require_columns,
-    require_complete_rows,
     silent,
-    split_header,
     wrap_angle,
 )
 from shipgym.sysid.io.registry import SourceFormat
@@ -54,8 +49,6 @@ _ESSO_WIND_COLS = ["wind_velo_relative_mid [m/s]", "wind_dir_relative_mid [rad]"
 def load_esso_osaka(path: Path, say: Callable[[str], None] = silent) -> Record:
     """Read one esso_osaka file (module docstring); ``say`` takes progress lines."""
     lines = read_lines(path)
-    cols = split_header(lines[0], ",")
-    ix = require_columns(path, "esso_osaka", cols, _ESSO_COLS)
     meta = base_meta(
         path,
         "esso_osaka",
@@ -65,12 +58,9 @@ def load_esso_osaka(path: Path, say: Callable[[str], None] = silent) -> Record:
         frame="pond frame O0-x0y0 (right-handed, z down); psi clockwise from x0",
         licence="CC BY-NC 4.0 (cite Wakita et al. 2022; Miyauchi et al. 2022)",
     )
-    data, n_empty = parse_table(lines[1:], ",", len(cols), path, 2, say)
-    report_empty_rows(n_empty, meta)
+    t, data, ix = read_columns(path, "esso_osaka", lines, ",", _ESSO_COLS, "t [s]", meta, say,
+                               optional=_ESSO_WIND_COLS)  # fmt: skip
     has_wind = all(c in ix for c in _ESSO_WIND_COLS)
-    used = _ESSO_COLS + (_ESSO_WIND_COLS if has_wind else [])
-    require_complete_rows(data, [ix[c] for c in used], meta)
-    t, data = repair_time(data[:, ix["t [s]"]], data, meta)
     r = data[:, ix["r_angvelo [rad/s]"]]
     delta = data[:, ix["delta_rudder [rad]"]]
     check_units(

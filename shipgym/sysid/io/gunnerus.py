@@ -17,15 +17,10 @@ from shipgym.sysid.ingest import (
     base_meta,
     check_units,
     flag_irregular,
-    parse_table,
+    read_columns,
     read_lines,
     repair_heading,
-    repair_time,
-    report_empty_rows,
-    require_columns,
-    require_complete_rows,
     silent,
-    split_header,
     warn_repair,
 )
 from shipgym.sysid.io.registry import SourceFormat
@@ -39,9 +34,7 @@ _GUNNERUS_SPEED_FIX = 1.9834 / (3600.0 / 1852.0)  # origin divided knots by 1.98
 def load_gunnerus(path: Path, say: Callable[[str], None] = silent) -> Record:
     """Read one gunnerus file (module docstring); ``say`` takes progress lines."""
     lines = read_lines(path)
-    cols = split_header(lines[0], ",")
     needed = ["tvec", "N", "E", "psi", "u", "v", "r", "Azi", "RPM"]
-    ix = require_columns(path, "gunnerus", cols, needed)
     meta = base_meta(
         path,
         "gunnerus",
@@ -50,10 +43,7 @@ def load_gunnerus(path: Path, say: Callable[[str], None] = silent) -> Record:
         scale="full",
         frame="north/east [m] (flat earth at 63.47 N, 10.54 E)",
     )
-    data, n_empty = parse_table(lines[1:], ",", len(cols), path, 2, say)
-    report_empty_rows(n_empty, meta)
-    require_complete_rows(data, [ix[c] for c in needed], meta)
-    t, data = repair_time(data[:, ix["tvec"]], data, meta)
+    t, data, ix = read_columns(path, "gunnerus", lines, ",", needed, "tvec", meta, say)
     deg = np.pi / 180.0
     r = data[:, ix["r"]] * deg
     azimuth = data[:, ix["Azi"]] * deg

@@ -19,13 +19,9 @@ from shipgym.sysid.ingest import (
     flag_irregular,
     header_error,
     measure_rudder_offset,
-    parse_table,
+    read_columns,
     read_lines,
     repair_heading,
-    repair_time,
-    report_empty_rows,
-    require_columns,
-    require_complete_rows,
     silent,
     split_header,
     warn_repair,
@@ -39,13 +35,11 @@ __all__ = ["FORMAT", "by_path", "load_sspa", "sniff"]
 def load_sspa(path: Path, say: Callable[[str], None] = silent) -> Record:
     """Read one sspa file (module docstring); ``say`` takes progress lines."""
     lines = read_lines(path)
-    cols = split_header(lines[0], ";")
     needed = ["time", "delta", "x0", "y0", "psi", "r"]
-    if len(cols) < 2:
+    if len(split_header(lines[0], ";")) < 2:
         raise header_error(
             path, "sspa", "a ';'-separated header 'time;delta;x0;y0;psi;r'", lines[0]
         )
-    ix = require_columns(path, "sspa", cols, needed)
     meta = base_meta(
         path,
         "sspa",
@@ -53,10 +47,7 @@ def load_sspa(path: Path, say: Callable[[str], None] = silent) -> Record:
         scale="model",
         frame="x0 along the approach course, y0 to starboard (earth-fixed)",
     )
-    data, n_empty = parse_table(lines[1:], ";", len(cols), path, 2, say)
-    report_empty_rows(n_empty, meta)
-    require_complete_rows(data, [ix[c] for c in needed], meta)
-    t, data = repair_time(data[:, ix["time"]], data, meta)
+    t, data, ix = read_columns(path, "sspa", lines, ";", needed, "time", meta, say)
     delta = -data[:, ix["delta"]]
     meta["conversions"].append("delta negated (source: positive rudder gives a port turn)")
     x, y = data[:, ix["x0"]], data[:, ix["y0"]]

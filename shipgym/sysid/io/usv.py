@@ -20,15 +20,10 @@ from shipgym.sysid.ingest import (
     derive_yaw_rate,
     flag_irregular,
     latlon_to_ne,
-    parse_table,
+    read_columns,
     read_lines,
     repair_heading,
-    repair_time,
-    report_empty_rows,
-    require_columns,
-    require_complete_rows,
     silent,
-    split_header,
 )
 from shipgym.sysid.io.registry import SourceFormat
 from shipgym.sysid.record import Record
@@ -40,9 +35,7 @@ __all__ = ["FORMAT", "by_path", "load_usv", "sniff"]
 def load_usv(path: Path, say: Callable[[str], None] = silent) -> Record:
     """Read one usv file (module docstring); ``say`` takes progress lines."""
     lines = read_lines(path)
-    cols = split_header(lines[0], ",")
     needed = ["time", "lon", "lat", "speed", "heading", "rudder"]
-    ix = require_columns(path, "usv", cols, needed)
     meta = base_meta(
         path,
         "usv",
@@ -51,10 +44,7 @@ def load_usv(path: Path, say: Callable[[str], None] = silent) -> Record:
         scale="full",
         frame="north/east [m] from the first GPS fix (WGS84 local tangent plane)",
     )
-    data, n_empty = parse_table(lines[1:], ",", len(cols), path, 2, say)
-    report_empty_rows(n_empty, meta)
-    require_complete_rows(data, [ix[c] for c in needed], meta)
-    t, data = repair_time(data[:, ix["time"]], data, meta)
+    t, data, ix = read_columns(path, "usv", lines, ",", needed, "time", meta, say)
     deg = np.pi / 180.0
     delta = data[:, ix["rudder"]] * deg
     x, y = latlon_to_ne(data[:, ix["lat"]], data[:, ix["lon"]])
