@@ -1504,7 +1504,10 @@ class MMGFit:
     factors : dict
         Refined derivative -> factor on the published value.
     stderr : dict
-        Standard errors of the factors (from the output-error Jacobian).
+        Standard errors of the factors and the effects' parameters (from the output-error
+        Jacobian).
+    actuators : dict
+        The actuator causes' parameters, as :attr:`VMMFit.actuators`.
     """
 
     params: MMGParams
@@ -1517,7 +1520,6 @@ class MMGFit:
         default_factory=lambda: RegressionResult({}, {}, {}, {}, {}, 0)
     )
     actuators: dict[str, float] = field(default_factory=dict)
-    term_set: str = ""
 
     @property
     def values(self) -> dict[str, float]:
