@@ -1883,7 +1883,8 @@ def _build_identify(sub: Any) -> None:
         type=_finite_float,
         default=0.3,
         metavar="FRAC",
-        help="fraction at the end of the record kept out of the fits for scoring "
+        help="fraction kept out of the fits for scoring: the end of one record, or of several "
+        "runs that many, each a manoeuvre of a kind a training run also makes "
         "(default: %(default)s)",
     )
     p.add_argument(

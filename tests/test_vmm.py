@@ -366,20 +366,83 @@ def test_on_records_of_the_mmg_model_a_rudder_zero_error_is_named() -> None:
 
 
 def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
-    """``vmm:auto`` fits every term set, keeps the one that predicts the held-out run best,
-    says which and by how much, and goes on with it."""
-    from shipgym.sysid.families.vmm import loop_terms
+    """``vmm:auto`` fits every term set, and the best two again with the single-screw
+    asymmetry as structure, keeps the one that predicts the held-out run best, says which and
+    by how much, and goes on with it."""
+    from shipgym.sysid.families.vmm import VMMAutoFamily, loop_terms
 
     runs = generate_vmm_runs(None, n_runs=3, seed=4, dt=0.5)
     said: list[str] = []
     result = identify(runs, "vmm:auto", max_effects=0, progress=said.append)
     sel = result.diagnostics["term_set_selection"]
     scores = sel["heldout_error"]
-    assert set(scores) == set(TERM_SETS)
+    symmetric = sorted(TERM_SETS, key=scores.__getitem__)
+    tries = symmetric[: VMMAutoFamily.ASYMMETRIC_TRIES]
+    assert set(scores) == set(TERM_SETS) | {f"{n}+turn_asymmetry" for n in tries}
     assert sel["chosen"] == min(scores, key=scores.__getitem__)
     assert set(result.parameters_after) == set(loop_terms(sel["chosen"], ()))
     assert any(line.startswith(f"term set {sel['chosen']} (") for line in said)
     assert result.to_dict()["term_set_selection"]["chosen"] == sel["chosen"]
+
+
+def test_term_set_names_take_the_single_screw_asymmetry_as_structure() -> None:
+    from shipgym.sysid.families.vmm import loop_terms, term_set_terms
+
+    terms = term_set_terms("martin_simple+turn_asymmetry")
+    assert terms == (*TERM_SETS["martin_simple"], "Y_|v|", "N_|v|", "Y_|r|", "N_|r|")
+    assert term_set_terms("linear") == TERM_SETS["linear"]
+    assert set(loop_terms("norrbin3+turn_asymmetry", ())) >= {"Y_|v|", "N_|r|"}
+    for bad in ("martin_simple+current", "nonsense", "linear+"):
+        with pytest.raises(ValueError, match="unknown term set"):
+            term_set_terms(bad)
+
+
+def _rudder(kind: str, amplitude_deg: float, side: float = 1.0) -> np.ndarray:
+    t = np.arange(0.0, 100.0, 0.5)
+    a = math.radians(amplitude_deg)
+    if kind == "turn":
+        return side * a * (t > 3.0)
+    return side * a * np.sign(np.sin(2.0 * math.pi * t / 40.0) + 1e-9)
+
+
+def test_manoeuvre_kinds() -> None:
+    from shipgym.sysid.families.base import manoeuvre_kind
+
+    assert manoeuvre_kind(_rudder("zigzag", 20.0)) == (True, 4)
+    assert manoeuvre_kind(_rudder("zigzag", 10.0, -1.0)) == (True, 2)
+    assert manoeuvre_kind(_rudder("turn", 35.0, -1.0)) == (False, 7)
+    spiked = _rudder("zigzag", 10.0)
+    spiked[50] = math.radians(40.0)  # one glitch does not make a 40 deg manoeuvre
+    assert manoeuvre_kind(spiked) == (True, 2)
+
+
+def test_held_out_runs_are_manoeuvres_a_training_run_also_makes() -> None:
+    """Several runs: the held-out ones each have a training run of their kind, whatever the
+    order of the files; the count is that of every ``1/holdout``-th run; when every manoeuvre
+    is made once, the score is an extrapolation and a note says so."""
+    from shipgym.sysid.families.base import holdout_runs, manoeuvre_kind
+
+    # the MMG generator's order: 10/10, 35 turn, 20/20 to starboard, then to port
+    mmg = [_rudder(k, a, s) for s in (1.0, -1.0)
+           for k, a in (("zigzag", 10.0), ("turn", 35.0), ("zigzag", 20.0))]  # fmt: skip
+    held, notes = holdout_runs(mmg, 0.3)
+    assert held == [2, 4] and not notes  # not both 20/20 zigzags: one stays in training
+    # the MARIN files in name order (tc -35, tc 35, zz -10, zz -20, zz 10, zz 20): as before
+    marin = [_rudder("turn", 35.0, -1.0), _rudder("turn", 35.0), _rudder("zigzag", 10.0, -1.0),
+             _rudder("zigzag", 20.0, -1.0), _rudder("zigzag", 10.0), _rudder("zigzag", 20.0)]
+    assert holdout_runs(marin, 0.3) == ([2, 5], [])
+    for runs in (mmg, marin, mmg[::-1], marin[1:]):
+        for frac in (0.2, 0.3, 0.5):
+            held, _ = holdout_runs(runs, frac)
+            assert len(held) == max(1, len(runs) // max(2, round(1.0 / frac)))
+            train = [manoeuvre_kind(runs[i]) for i in range(len(runs)) if i not in held]
+            assert all(manoeuvre_kind(runs[i]) in train for i in held)
+    single = [_rudder("zigzag", a) for a in (5.0, 10.0, 15.0, 20.0)]
+    held, notes = holdout_runs(single, 0.3, ["z5", "z10", "z15", "z20"])
+    assert held == [2] and notes == [
+        "held-out run z15 (zigzag, rudder about 15 deg) is the only one of its kind: its score "
+        "is an extrapolation"
+    ]
 
 
 def test_single_run_families_refuse_several_records(wind_runs) -> None:
@@ -474,7 +537,9 @@ def test_kvlcc2_mmg_derivatives_refined_on_hsva_runs() -> None:
     """The MMG model's resistance and linear hull derivatives, refined on HSVA runs by output
     error, stay inside their bounds, move the published yaw damping by many standard errors
     (less damping: the published model under-predicts the overshoots) and predict the
-    held-out runs within a few degrees."""
+    held-out runs (the 10/10 and 20/10 zigzags, each with a partner in training) within a few
+    degrees. (The published model predicts them to 5.8 deg: the refinement on four x/5
+    zigzags does not generalise to the x/10 ones, a finding the README reports.)"""
     from shipgym.sysid.families.vmm import MMG_FACTOR_BOUNDS
 
     keep = ("10_05", "20_05", "10_10_S", "20_10_P", "35_05", "15_05")
@@ -484,7 +549,9 @@ def test_kvlcc2_mmg_derivatives_refined_on_hsva_runs() -> None:
     lo, hi = MMG_FACTOR_BOUNDS
     assert all(lo < f < hi for f in fit.factors.values()), fit.factors
     assert fit.factors["n_r"] < 1.0 - 3.0 * fit.stderr["n_r"]
-    assert result.heldout["error_after"]["psi_rms_deg"] < 5.0
+    assert result.heldout["runs"] == ["HSVA_CPMC_KVLCC2_Z_10_10_S.dat",
+                                      "HSVA_CPMC_KVLCC2_Z_20_10_P.dat"]  # fmt: skip
+    assert result.heldout["error_after"]["psi_rms_deg"] < 7.0
     assert result.to_dict()["kvlcc2"]["n_r"] == pytest.approx(fit.params.n_r)
 
 

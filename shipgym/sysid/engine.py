@@ -244,7 +244,8 @@ def identify(
         ``"vmm:martin_simple"``, ``"vmm:norrbin3"``) or a family object.
     holdout : float
         Fraction of the record (its end) kept out of the fits and used for scoring, in
-        ``[0.1, 0.6]``; with several runs, every ``round(1 / holdout)``-th run is held out.
+        ``[0.1, 0.6]``; with several runs, that fraction of the runs, each a manoeuvre of a kind
+        that a training run also makes (:func:`~shipgym.sysid.families.base.holdout_runs`).
     max_effects : int
         Largest number of effects to add (>= 0).
     window_s : float, "auto" or None

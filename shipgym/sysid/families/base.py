@@ -62,9 +62,11 @@ __all__ = [
     "causes",
     "errors",
     "get_family",
+    "holdout_runs",
     "jsonable",
     "lag_filter",
     "ljung_box",
+    "manoeuvre_kind",
     "register",
     "shift",
     "undetermined",
@@ -434,6 +436,82 @@ def window_starts(t: np.ndarray, window_s: float | None) -> np.ndarray:
     return starts
 
 
+MANOEUVRE_STEP_DEG = 5.0
+"""Rudder amplitudes within this many degrees of each other are one kind of manoeuvre (a 20/5
+and a 20/10 zigzag are alike; a 10/10 and a 20/20 zigzag are not)."""
+
+
+def manoeuvre_kind(delta: np.ndarray) -> tuple[bool, int]:
+    """The kind of manoeuvre a recorded rudder makes: whether it reverses (a zigzag or a random
+    manoeuvre, against a turn or a pull-out) and its amplitude in steps of
+    :data:`MANOEUVRE_STEP_DEG` (the 98th percentile of ``|delta|``, robust to a spike)."""
+    d = np.asarray(delta, dtype=np.float64)
+    d = d[np.isfinite(d)]
+    if d.size == 0:
+        return False, 0
+    amplitude = float(np.percentile(np.abs(d), 98.0))
+    reverses = bool(d.max() > 0.3 * amplitude and d.min() < -0.3 * amplitude)
+    return reverses, round(math.degrees(amplitude) / MANOEUVRE_STEP_DEG)
+
+
+def holdout_runs(
+    deltas: list[np.ndarray], holdout: float, names: list[str] | None = None
+) -> tuple[list[int], list[str]]:
+    """The runs held out of the fits and used for scoring, when several runs are identified
+    together: ``n // round(1 / holdout)`` of them (at least one), each a manoeuvre of a kind
+    (:func:`manoeuvre_kind`) that a training run also makes, so that the score measures how
+    the model predicts manoeuvres like those it was fitted on, not an extrapolation to a rudder
+    amplitude it never saw (whatever order the files come in).
+
+    The runs are taken in this order of preference: every ``round(1 / holdout)``-th run, then
+    the others from the last; a run is held out when another run of its kind stays in the
+    training set. When too few runs have a partner (every manoeuvre made once), the rest come
+    from that order all the same, and a note names them.
+
+    Parameters
+    ----------
+    deltas : list of ndarray
+        The recorded rudder angle [rad] of every run.
+    holdout : float
+        Fraction of the runs to hold out (the ``holdout`` of
+        :func:`~shipgym.sysid.engine.identify`).
+    names : list of str, optional
+        The runs' names, for the notes (default: their indices).
+
+    Returns
+    -------
+    held : list of int
+        Indices of the held-out runs, ascending.
+    notes : list of str
+        One line per held-out run whose kind no training run makes.
+    """
+    n = len(deltas)
+    k = max(2, round(1.0 / holdout))
+    n_held = max(1, n // k)
+    kinds = [manoeuvre_kind(d) for d in deltas]
+    order = [i for i in range(n) if i % k == k - 1]
+    order += [i for i in reversed(range(n)) if i not in order]
+    held: list[int] = []
+    for i in order:
+        if len(held) < n_held and any(
+            kinds[j] == kinds[i] for j in range(n) if j != i and j not in held
+        ):
+            held.append(i)
+    notes = []
+    for i in order:
+        if len(held) >= n_held:
+            break
+        if i not in held:
+            held.append(i)
+            kind = "zigzag" if kinds[i][0] else "turn"
+            amplitude = kinds[i][1] * MANOEUVRE_STEP_DEG
+            notes.append(
+                f"held-out run {names[i] if names else i} ({kind}, rudder about {amplitude:g} "
+                "deg) is the only one of its kind: its score is an extrapolation"
+            )
+    return sorted(held), notes
+
+
 def bic(rss: Mapping[str, float], n: int, k: int) -> float:
     """Gaussian (unknown-variance) BIC ``sum_ch n log(RSS_ch / n) + k log(n_ch n)``."""
     return sum(n * math.log(max(s, 1e-30) / n) for s in rss.values()) + k * math.log(
@@ -625,4 +703,3 @@ def actual_rudder(
     if rudder_lag is not None and rudder_lag > 0.0:
         d = lag_filter(t, d, rudder_lag, y0, gear)
     return d
-

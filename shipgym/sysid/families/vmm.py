@@ -22,12 +22,17 @@ The seed's identification, through the one engine (:mod:`shipgym.sysid.engine`):
    with the coefficients fixed (:func:`predict`, as a validation on new data estimates its
    initial condition).
 3. **Cross-validation across runs**: the engine fits on some runs and scores on the others
-   (:meth:`VMMFamily.prepare`: every ``1/holdout``-th run is held out; a single run is split in
-   time). Effects (:data:`VMM_EFFECTS`): ``asymmetry`` (constant side force and moment: the
-   propeller's and a rudder zero error), ``current`` (a constant current, in the relative
-   velocities), ``rudder_slipstream`` (rudder force growing with the propeller loading,
-   ``Y_Td, N_Td``) and ``wind`` (the apparent wind's surge force, side force and yaw moment,
-   for records with wind channels: Esso Osaka).
+   (:meth:`VMMFamily.prepare`: a ``holdout`` fraction of the runs is held out, each a
+   manoeuvre of a kind a training run also makes,
+   :func:`~shipgym.sysid.families.base.holdout_runs`; a single run is split in time).
+   ``vmm:auto`` (:class:`VMMAutoFamily`) chooses the structure the same way: the term set, and
+   whether the single-screw turn asymmetry belongs to it. Effects (:data:`VMM_EFFECTS`):
+   ``asymmetry`` (constant side force and moment: the propeller's and a rudder zero error),
+   ``turn_asymmetry`` (even sway and yaw terms), ``current`` (a constant current, in the
+   relative velocities), ``rudder_slipstream`` (rudder force growing with the propeller
+   loading, ``Y_Td, N_Td``), ``wind`` (the apparent wind's surge force, side force and yaw
+   moment, for records with wind channels) and the shared actuator causes (rudder zero error,
+   steering-gear lag, input delay).
 
 Particulars (mass, inertia, ``x_G``, added masses) come from :func:`vessel_params` for the
 records it knows (KVLCC2 at HSVA and MARIN; Esso Osaka), or from the caller's
@@ -74,6 +79,7 @@ from shipgym.sysid.families.base import (
     actual_rudder,
     bic,
     causes,
+    holdout_runs,
     register,
     undetermined,
     window_starts,
@@ -83,6 +89,7 @@ from shipgym.sysid.families.base import (
 __all__ = [
     "COLLINEAR_RCOND",
     "FILTER_LENGTHS",
+    "STRUCTURE_EFFECTS",
     "VMM_EFFECTS",
     "RegressionResult",
     "VMMFamily",
@@ -94,6 +101,7 @@ __all__ = [
     "refine",
     "regress",
     "replay",
+    "term_set_terms",
     "vessel_params",
 ]
 
@@ -293,6 +301,7 @@ def vessel_params(record: Record) -> VMMParams:
         " (ships known without: hsva, marin, esso_osaka records)"
     )
 
+
 # --------------------------------------------------------------------------------------------
 # records prepared for regression and replay
 
@@ -323,6 +332,11 @@ def _cut(record: Record) -> Record:
     return record.slice(float(t0), float(t1))
 
 
+def _run_name(record: Record, index: int) -> str:
+    """How a run is named in messages and reports: its file, its source or its index."""
+    return str(record.meta.get("file") or record.meta.get("source") or f"run {index}")
+
+
 def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
     """Smooth and differentiate every record over :data:`FILTER_LENGTHS` ship lengths.
 
@@ -335,7 +349,7 @@ def prepare_runs(records: Sequence[Record], params: VMMParams) -> list[_Run]:
     runs = []
     for rec in records:
         rec = _cut(rec)
-        name = str(rec.meta.get("file") or rec.meta.get("source") or f"run {len(runs)}")
+        name = _run_name(rec, len(runs))
         missing = [k for k in ("x", "y", "u", "v") if getattr(rec, k) is None]
         if missing:
             raise ValueError(
@@ -800,13 +814,44 @@ def actuator_document(params: VMMParams | MMGParams, actuators: Mapping[str, flo
     return doc
 
 
+STRUCTURE_EFFECTS: tuple[str, ...] = ("turn_asymmetry",)
+"""Effects that ``vmm:auto`` may take into the hull's structure, by the cross-validation that
+chooses the term set (:class:`VMMAutoFamily`): the port/starboard difference of a single-screw
+ship in a turn is the ship itself, not an undeclared cause (the MMG method builds it in:
+Yasukawa and Yoshimura 2015 give the rudder's flow-straightening coefficient per side, and the
+published KVLCC2 turns at +2.3 and -2.6 deg/s at +-10 deg of rudder)."""
+
+
+def term_set_terms(name: str) -> tuple[str, ...]:
+    """The terms of a term set: a name of :data:`~shipgym.models.vmm.TERM_SETS`, optionally
+    followed by ``+effect`` for effects of :data:`STRUCTURE_EFFECTS` that are part of the
+    structure (``"martin_simple+turn_asymmetry"``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown term set or structure effect.
+    """
+    base, *extra = name.split("+")
+    if base not in TERM_SETS or any(e not in STRUCTURE_EFFECTS for e in extra):
+        raise ValueError(
+            f"unknown term set {name!r}; expected one of {tuple(TERM_SETS)}, optionally with "
+            f"+{' or +'.join(STRUCTURE_EFFECTS)}"
+        )
+    terms = list(TERM_SETS[base])
+    for e in extra:
+        terms += [t for t in _EFFECT_TERMS[e] if t not in terms]
+    return tuple(terms)
+
+
 def loop_terms(term_set: str | Sequence[str], effects: Sequence[str]) -> list[str]:
-    """The terms of the loop's model: a named set without its :data:`ASYMMETRY_TERMS` unless
-    ``asymmetry`` is in, then the effects' own terms; an explicit list of terms as given."""
+    """The terms of the loop's model: a named set (:func:`term_set_terms`) without its
+    :data:`ASYMMETRY_TERMS` unless ``asymmetry`` is in, then the effects' own terms; an explicit
+    list of terms as given."""
     if not isinstance(term_set, str):
         base = list(term_set)
     else:
-        full = TERM_SETS[term_set]
+        full = term_set_terms(term_set)
         base = [t for t in full if t not in ASYMMETRY_TERMS]
         if "asymmetry" in effects:
             base += [t for t in full if t in ASYMMETRY_TERMS] or list(_EFFECT_TERMS["asymmetry"])
@@ -1125,6 +1170,7 @@ class _Context:
     window_s: float | None
     term_set: str
     selection: dict[str, Any] = field(default_factory=dict)  # vmm:auto's choice of term set
+    holdout_notes: list[str] = field(default_factory=list)  # held-out runs without a partner
 
 
 def _equation_error(fit: VMMFit) -> float:
@@ -1190,7 +1236,7 @@ class VMMFamily(ModelFamily):
         """The catalogue less the effects whose terms the term set holds already (its
         straight-running side force and moment, :data:`ASYMMETRY_TERMS`, are the
         ``asymmetry`` effect's)."""
-        terms = set(TERM_SETS[current.fitted.term_set or self.term_set])
+        terms = set(term_set_terms(current.fitted.term_set or self.term_set))
         skip = {e for e, t in _EFFECT_TERMS.items() if e != "asymmetry" and set(t) <= terms}
         return [e for e in super().candidates(current) if e not in skip]
 
@@ -1201,6 +1247,7 @@ class VMMFamily(ModelFamily):
             template = replace(template, thrust_from="rps")
         if template.thrust_from == "rps":
             records = [replace(r, thrust=None) if r.thrust is not None else r for r in records]
+        holdout_notes: list[str] = []
         if len(records) == 1:  # one run: split in time
             rec = records[0]
             cut = _cut(rec)
@@ -1209,8 +1256,11 @@ class VMMFamily(ModelFamily):
                        cut.slice(t_split, float(cut.time[-1]))]  # fmt: skip
             train, held = [0], [1]
         else:
-            k = max(2, round(1.0 / holdout))
-            held = [i for i in range(len(records)) if i % k == k - 1] or [len(records) - 1]
+            held, holdout_notes = holdout_runs(
+                [r.delta for r in records],
+                holdout,
+                [_run_name(r, i) for i, r in enumerate(records)],
+            )
             train = [i for i in range(len(records)) if i not in held]
         runs = prepare_runs(records, template)
         speed = float(np.median(np.concatenate([np.hypot(r.states[:, 3], r.states[:, 4])
@@ -1221,7 +1271,8 @@ class VMMFamily(ModelFamily):
         rp = _build_replay(runs, template, window_s)
         shooting = REFINE_WINDOW_LENGTHS * lengths_s
         rp_fit = _build_replay(runs, template, min(shooting, window_s or math.inf))
-        return _Context(runs, rp, rp_fit, train, held, template, window_s, self.term_set)
+        return _Context(runs, rp, rp_fit, train, held, template, window_s, self.term_set,
+                        holdout_notes=holdout_notes)  # fmt: skip
 
     def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
         """Held-out runs replayed with each window's initial sway and yaw rate estimated
@@ -1386,8 +1437,11 @@ class VMMFamily(ModelFamily):
             "before": predict(base.fitted, ctx.rp, ctx.held),
             "after": predict(final.fitted, ctx.rp, ctx.held),
         }
+        for note in ctx.holdout_notes:
+            say(note)
         heldout = {
             "runs": [ctx.runs[i].name for i in ctx.held],
+            "notes": list(ctx.holdout_notes),
             "error_before": _rms(held_sims["before"][held_mask], ctx.rp.measured[held_mask]),
             "error_after": _rms(held_sims["after"][held_mask], ctx.rp.measured[held_mask]),
             "per_run": {
@@ -1653,15 +1707,22 @@ def describe_selection(selection: Mapping[str, Any]) -> str:
 
 
 class VMMAutoFamily(VMMFamily):
-    """``vmm:auto``: the VMM whose term set predicts the held-out runs best.
+    """``vmm:auto``: the VMM whose structure predicts the held-out runs best.
 
     Every term set of :data:`~shipgym.models.vmm.TERM_SETS` is fitted as a base model on the
     training runs (regression and refinement, two at a time) and scored on the held-out runs,
-    the same cross-validation across runs that then judges the effects; the set with the lowest
-    held-out error (the geometric mean of the ``psi, r, u, v`` RMS) wins, and the loop goes on
-    with it. The scores of every set are said and kept in the diagnostics
+    the same cross-validation across runs that then judges the effects; the best
+    :attr:`ASYMMETRIC_TRIES` sets are fitted again with the single-screw port/starboard
+    difference as part of the structure (:data:`STRUCTURE_EFFECTS`, ``"<set>+turn_asymmetry"``).
+    The structure with the lowest held-out error (the geometric mean of the ``psi, r, u, v``
+    RMS) wins, and the loop goes on with it: a symmetric ship keeps a symmetric structure, an
+    asymmetric one does not leave its asymmetry for the loop to mistake for a rudder zero error.
+    The scores of every structure are said and kept in the diagnostics
     (``term_set_selection``).
     """
+
+    #: How many of the best symmetric term sets are tried with :data:`STRUCTURE_EFFECTS`.
+    ASYMMETRIC_TRIES = 2
 
     def __init__(self) -> None:
         super().__init__("martin_simple")
@@ -1674,16 +1735,27 @@ class VMMAutoFamily(VMMFamily):
             except (ValueError, np.linalg.LinAlgError) as exc:
                 return exc
 
-        names = list(TERM_SETS)
-        with ThreadPoolExecutor(max_workers=2) as pool:
-            outcomes = dict(zip(names, pool.map(base, names), strict=True))
+        def fit(names: list[str]) -> dict[str, Candidate | Exception]:
+            with ThreadPoolExecutor(max_workers=2) as pool:
+                return dict(zip(names, pool.map(base, names), strict=True))
+
+        def ranking() -> list[str]:
+            return sorted(
+                (n for n, c in outcomes.items() if isinstance(c, Candidate)),
+                key=lambda n: outcomes[n].heldout_error,
+            )  # type: ignore[union-attr]
+
+        outcomes = fit(list(TERM_SETS))
+        tries = [n for n in ranking() if math.isfinite(outcomes[n].heldout_error)]  # type: ignore[union-attr]
+        outcomes |= fit([f"{n}+{e}" for n in tries[: self.ASYMMETRIC_TRIES]
+                         for e in STRUCTURE_EFFECTS])  # fmt: skip
         fitted = {n: c for n, c in outcomes.items() if isinstance(c, Candidate)}
-        ranked = sorted(fitted, key=lambda n: fitted[n].heldout_error)
+        ranked = ranking()
         if not ranked or not math.isfinite(fitted[ranked[0]].heldout_error):
             raise ValueError(f"no term set could be fitted and replayed: {outcomes}")
         for n in ranked:
             say(f"  term set {n}: held-out error {fitted[n].heldout_error:.4g}")
-        for n in set(names) - set(fitted):
+        for n in set(outcomes) - set(fitted):
             say(f"  term set {n}: failed ({outcomes[n]})")
         scores = {n: fitted[n].heldout_error for n in ranked}
         runner_up = next((n for n in ranked[1:] if math.isfinite(scores[n])), None)
