@@ -124,6 +124,7 @@ def _case(task: tuple[str | None, int, str, int]) -> dict[str, Any]:
     row |= {
         "named": named,
         "first": named[0] if named else None,
+        "structure": (res.diagnostics.get("term_set_selection") or {}).get("chosen"),
         "heldout_runs": res.heldout.get("runs", []),
         "footprint_psi_deg": footprint(effect, seed, n_runs, res.heldout.get("runs", [])),
         "heldout_psi_before_deg": before,
@@ -162,6 +163,7 @@ def summarise(rows: list[dict[str, Any]], effects: list[str]) -> dict[str, dict[
             "median_before_deg": _median([r["heldout_psi_before_deg"] for r in ok]),
             "median_after_deg": _median([r["heldout_psi_after_deg"] for r in ok]),
             "median_footprint_deg": _median([r["footprint_psi_deg"] for r in ok]),
+            "asymmetric_structure": sum("+" in (r.get("structure") or "") for r in ok),
         }
         if effect == CLEAN:
             entry["no_actuator_effect"] = entry["passed"]
@@ -215,6 +217,15 @@ def render(doc: dict[str, Any]) -> str:
             f"{_f(s['median_before_deg'])} → {_f(s['median_after_deg'])} | "
             f"{_f(s['median_footprint_deg'])} | {named} |"
         )
+    lines += [
+        "",
+        "Structure chosen with the turn asymmetry (`<term set>+turn_asymmetry`): "
+        + ", ".join(
+            f"{effect.replace('_', ' ')} {s['asymmetric_structure']}/{n}"
+            for effect, s in doc["summary"].items()
+        )
+        + ".",
+    ]
     failed = sum(s["failed"] for s in doc["summary"].values())
     if failed:
         lines += ["", f"{failed} identifications failed (see `docs/mmg_records.json`)."]
