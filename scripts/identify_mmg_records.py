@@ -6,6 +6,12 @@ Usage::
     python scripts/identify_mmg_records.py [--model vmm:auto] [--seeds 6] [--effects E ...]
                                            [--n-runs 6] [--jobs 2] [--out docs]
                                            [--readme README.md | --no-readme]
+                                           [--simulator shipgym|shipmmg]
+
+    # the same runs with their motions made by ShipMMG, in its own environment:
+    python -m venv --system-site-packages /tmp/shipmmg-venv
+    /tmp/shipmmg-venv/bin/pip install shipmmg        # ShipMMG pins Pillow < 11: keep it apart
+    /tmp/shipmmg-venv/bin/python scripts/identify_mmg_records.py --simulator shipmmg
 
 For every effect of :data:`shipgym.sysid.generator.MMG_EFFECTS` and the clean ship, and every
 seed ``0 .. seeds-1``, :func:`shipgym.sysid.generator.generate_mmg_runs` makes the runs of the
@@ -26,6 +32,11 @@ both; for the clean records how often no actuator effect
 the effect's *footprint* (:func:`footprint`): the held-out heading RMS of the true hull driven
 by the recorded rudder without the effect, the most that naming it can take off a perfect
 model's error (the script reads the truth for it; the identification never does).
+
+With ``--simulator shipmmg`` the motions come from ShipMMG instead (:func:`shipmmg_runs`; no
+wind: ShipMMG has no wind loads), a cross-check that the counts are not an artefact of
+shipgym's own MMG code; the footprint is still shipgym's, and the outputs and README block are
+named ``mmg_records_shipmmg``.
 
 Writes ``OUT/mmg_records.json``, ``OUT/mmg_records.png`` and the README block between
 ``<!-- mmg_records -->`` and ``<!-- /mmg_records -->``.
@@ -54,9 +65,11 @@ from matplotlib.ticker import ScalarFormatter
 from shipgym.models import make_model
 from shipgym.models import mmg as _mmg
 from shipgym.models.mmg import MMGParams
+from shipgym.models.nomoto import SteeringGear
 from shipgym.sysid import identify
-from shipgym.sysid.families.base import FAMILIES
-from shipgym.sysid.generator import MMG_EFFECTS, generate_mmg_runs
+from shipgym.sysid.data import Record
+from shipgym.sysid.families.base import FAMILIES, actual_rudder
+from shipgym.sysid.generator import MMG_EFFECTS, MMG_NOISE, generate_mmg_runs
 from shipgym.sysid.report import replace_between_markers, update_readme, write_json
 
 REPO = Path(__file__).resolve().parents[1]
@@ -107,12 +120,76 @@ def footprint(effect: str | None, seed: int, n_runs: int, held: list[str]) -> fl
     return math.sqrt(sq / n) if n else math.nan
 
 
-def _case(task: tuple[str | None, int, str, int]) -> dict[str, Any]:
+SIMULATOR_NAMES = {"shipgym": "shipgym's", "shipmmg": "ShipMMG's"}
+"""Who makes the motions of the records (``--simulator``)."""
+
+SHIPMMG_EFFECTS = ("rudder_offset", "rudder_lag", "input_delay", "current")
+"""Effects the ShipMMG records can carry (ShipMMG has no wind loads)."""
+
+
+def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
+    """The runs of :func:`generate_mmg_runs` with their motions made again by ShipMMG
+    (``shipmmg.mmg_3dof.simulate``, an independent implementation of the same MMG KVLCC2, its
+    parameters as in ``scripts/shipmmg_compare.py``; run in its own environment, see the usage).
+
+    Each run keeps its recorded rudder, rpm, start and length. ShipMMG is driven by the rudder the
+    ship feels (:func:`~shipgym.sysid.families.base.actual_rudder` of the recorded one under the
+    true zero error, gear lag or delay); a current is added to ShipMMG's motion through the
+    water (positions and body velocities over ground). Noise of :data:`MMG_NOISE` on every
+    channel, from its own seeded stream. Raises ``ImportError`` without ShipMMG.
+    """
+    from shipmmg.mmg_3dof import simulate
+    from shipmmg_compare import _shipmmg_params
+
+    p = MMGParams.kvlcc2()
+    rng = np.random.default_rng([seed, 1729])
+    out = []
+    for rec in generate_mmg_runs(effect, seed=seed, noise=False, n_runs=n_runs):
+        truth = rec.meta["truth"]
+        e = truth["effect_parameters"]
+        t = rec.time
+        felt = actual_rudder(
+            t, rec.delta, rudder_offset=e.get("delta_0", 0.0), rudder_lag=e.get("T_delta"),
+            input_delay=e.get("tau", 0.0), y0=truth["x0"][_mmg.IDELTA],
+            gear=SteeringGear(max_angle=p.max_rudder, max_rate=p.rudder_rate),
+        )  # fmt: skip
+        v_n, v_e = truth["current"]
+        psi0 = float(rec.psi[0])
+        cs, sn = math.cos(psi0), math.sin(psi0)
+        sol = simulate(
+            **_shipmmg_params(p), time_list=list(t), δ_list=list(felt),
+            nps_list=list(rec.rpm / 60.0), u0=float(rec.u[0]) - v_n * cs - v_e * sn,
+            v0=float(rec.v[0]) + v_n * sn - v_e * cs, r0=float(rec.r[0]), ψ0=psi0,
+            ρ=p.rho, t_eval=t, rtol=1e-8, atol=1e-8,
+        )  # fmt: skip
+        u_w, v_w, r, x, y, psi = sol.y[:6]
+        cp, sp = np.cos(psi), np.sin(psi)
+        u = u_w + v_n * cp + v_e * sp
+        v = v_w - v_n * sp + v_e * cp
+
+        def noisy(a: np.ndarray, key: str) -> np.ndarray:
+            return a + rng.normal(0.0, MMG_NOISE[key], a.shape[0])
+
+        u, v = noisy(u, "uv"), noisy(v, "uv")
+        meta = {k: v for k, v in rec.meta.items() if k != "truth"}
+        meta |= {"source": "shipmmg", "truth": {**truth, "simulator": "ShipMMG"}}
+        out.append(Record(
+            time=t, delta=noisy(rec.delta, "delta"), psi=noisy(psi, "psi"), r=noisy(r, "r"),
+            x=noisy(x + v_n * (t - t[0]), "xy"), y=noisy(y + v_e * (t - t[0]), "xy"), u=u, v=v,
+            U=np.hypot(u, v), rpm=noisy(rec.rpm, "rpm"), meta=meta,
+        ))  # fmt: skip
+    return out
+
+
+def _case(task: tuple[str | None, int, str, int, str]) -> dict[str, Any]:
     """Generate one effect and seed and identify it (a process-pool task)."""
-    effect, seed, model, n_runs = task
+    effect, seed, model, n_runs, simulator = task
     row: dict[str, Any] = {"effect": effect or CLEAN, "seed": seed}
     t0 = time.perf_counter()
-    runs = generate_mmg_runs(effect, seed=seed, n_runs=n_runs)
+    if simulator == "shipmmg":
+        runs = shipmmg_runs(effect, seed, n_runs)
+    else:
+        runs = generate_mmg_runs(effect, seed=seed, n_runs=n_runs)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -190,7 +267,8 @@ def render(doc: dict[str, Any]) -> str:
     n = doc["n_seeds"]
     lines = [
         f"The 3-DOF loop (`{doc['model']}`) on runs of the KVLCC2 L7 model made by the MMG "
-        f"standard model, a structure its polynomials do not share: {doc['n_runs']} runs of "
+        f"standard model ({SIMULATOR_NAMES[doc.get('simulator', 'shipgym')]}), a structure its "
+        f"polynomials do not share: {doc['n_runs']} runs of "
         "90-120 s (10/10 and 20/20 zigzags and 35 deg turns to both sides) with noise on every "
         f"channel and one undeclared effect, {n} seed{'s' if n != 1 else ''} each; held out "
         f"(the default hold-out): {_held(doc)}. "
@@ -228,7 +306,7 @@ def render(doc: dict[str, Any]) -> str:
     ]
     failed = sum(s["failed"] for s in doc["summary"].values())
     if failed:
-        lines += ["", f"{failed} identifications failed (see `docs/mmg_records.json`)."]
+        lines += ["", f"{failed} identifications failed (see the JSON beside the figure)."]
     lines += ["", f"Made by `python scripts/identify_mmg_records.py` in {doc['runtime_s']:.0f} s."]
     return "\n".join(lines)
 
@@ -280,8 +358,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--model", default=DEFAULT_MODEL, help=f"model (default {DEFAULT_MODEL})")
     ap.add_argument("--seeds", type=int, default=6, help="seeds 0 .. N-1 (default 6)")
     kinds = [CLEAN, *MMG_EFFECTS]
-    ap.add_argument("--effects", nargs="+", choices=kinds, default=kinds,
-                    help="records to make (default all)")  # fmt: skip
+    ap.add_argument("--effects", nargs="+", choices=kinds, default=None,
+                    help="records to make (default all the simulator can make)")  # fmt: skip
+    ap.add_argument("--simulator", choices=tuple(SIMULATOR_NAMES), default="shipgym",
+                    help="who makes the motions: shipgym's MMG model (default) or ShipMMG, "
+                    "in an environment that has it (usage above)")  # fmt: skip
     ap.add_argument("--n-runs", type=int, default=6, help="runs per record set (default 6)")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
@@ -290,10 +371,20 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.seeds < 1:
         ap.error(f"--seeds must be >= 1, got {args.seeds}")
+    possible = kinds if args.simulator == "shipgym" else [CLEAN, *SHIPMMG_EFFECTS]
+    args.effects = args.effects or possible
+    if not set(args.effects) <= set(possible):
+        ap.error(f"--simulator {args.simulator} makes only {', '.join(possible)}")
+    if args.simulator == "shipmmg":
+        try:
+            import shipmmg  # noqa: F401
+        except ImportError:
+            ap.error("--simulator shipmmg: ShipMMG is not installed here (usage above)")
+    name = "mmg_records" + ("" if args.simulator == "shipgym" else f"_{args.simulator}")
     if not args.no_readme:  # before an hour of fits, not after
         try:
             text = Path(args.readme).read_text(encoding="utf-8")
-            replace_between_markers(text, "mmg_records", "")
+            replace_between_markers(text, name, "")
         except (OSError, ValueError) as exc:
             ap.error(f"--readme {args.readme}: {exc} (or pass --no-readme)")
     model = args.model
@@ -302,7 +393,7 @@ def main(argv: list[str] | None = None) -> int:
         model = FALLBACK_MODEL
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = [(None if e == CLEAN else e, seed, model, args.n_runs)
+    tasks = [(None if e == CLEAN else e, seed, model, args.n_runs, args.simulator)
              for e in args.effects for seed in range(args.seeds)]  # fmt: skip
     _say(f"{len(tasks)} identifications with {model} on {args.jobs} processes ...")
     t0 = time.perf_counter()
@@ -326,6 +417,7 @@ def main(argv: list[str] | None = None) -> int:
     summary = summarise(rows, args.effects)
     doc = {
         "model": model,
+        "simulator": args.simulator,
         "n_seeds": args.seeds,
         "n_runs": args.n_runs,
         "actuator_effects": list(ACTUATOR_EFFECTS),
@@ -345,11 +437,11 @@ def main(argv: list[str] | None = None) -> int:
             f"median {_f(s['median_before_deg'])} -> {_f(s['median_after_deg'])} deg"
             f"{'' if s['target_met'] else '  (target missed)'}"
         )
-    write_json(doc, out / "mmg_records.json")
-    plot(doc, out / "mmg_records.png")
+    write_json(doc, out / f"{name}.json")
+    plot(doc, out / f"{name}.png")
     if not args.no_readme:
-        update_readme(Path(args.readme), render(doc), "mmg_records")
-    _say(f"wrote {out / 'mmg_records.json'} and .png in {doc['runtime_s']:.0f} s")
+        update_readme(Path(args.readme), render(doc), name)
+    _say(f"wrote {out / name}.json and .png in {doc['runtime_s']:.0f} s")
     return 0
 
 

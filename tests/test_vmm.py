@@ -406,6 +406,23 @@ def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     assert result.to_dict()["term_set_selection"]["chosen"] == sel["chosen"]
 
 
+def test_a_model_that_diverges_on_its_own_training_runs_is_no_candidate() -> None:
+    """A candidate must replay the runs it was fitted on, not only the held-out ones: a course
+    that runs away on a training run scores ``inf`` and says why (the held-out runs are left
+    out here so that only the training runs can tell)."""
+    from shipgym.sysid.families.base import FAMILIES
+
+    family = FAMILIES["vmm:linear"]
+    ctx = family.prepare(generate_vmm_runs(None, n_runs=3, seed=4, dt=0.5), 0.3, "auto")
+    fit = family._candidate(ctx, ()).fitted
+    assert math.isfinite(family._score(ctx, fit).heldout_error)
+    coefficients = dict(fit.params.coefficients)
+    coefficients["N_r"] = 50.0 * abs(coefficients["N_r"])  # yaw "damping" that feeds the turn
+    unstable = replace(fit, params=fit.params.with_coefficients(coefficients))
+    cand = family._score(replace(ctx, held=[]), unstable)
+    assert math.isinf(cand.J) and cand.extra["diverges_on"] == "its training runs"
+
+
 def test_term_set_names_take_the_single_screw_asymmetry_as_structure() -> None:
     from shipgym.sysid.families.vmm import loop_terms, term_set_terms
 

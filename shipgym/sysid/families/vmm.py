@@ -1276,12 +1276,20 @@ class VMMFamily(ModelFamily):
 
     def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
         """Held-out runs replayed with each window's initial sway and yaw rate estimated
-        (:func:`predict`), scored by the BIC of ``psi, r, u, v``."""
+        (:func:`predict`), scored by the BIC of ``psi, r, u, v``. A model that diverges when
+        it replays a run, held-out or one of its own training runs, scores ``inf``: it is not a
+        model of the ship (seen on ShipMMG-made runs with a current: a term set that predicted
+        the held-out runs diverged on its own training turn, and the report could not be
+        made)."""
         sim = predict(fit, ctx.rp, ctx.held)
         mask = ctx.rp.run_mask(ctx.held)
         n = int(mask.sum())
+        diverges = Candidate(fit.effects, fit, math.inf, math.inf)
         if not np.all(np.isfinite(sim[mask])):
-            return Candidate(fit.effects, fit, math.inf, math.inf)
+            return diverges
+        if not np.all(np.isfinite(predict(fit, ctx.rp, ctx.train)[ctx.rp.run_mask(ctx.train)])):
+            diverges.extra["diverges_on"] = "its training runs"
+            return diverges
         e = _channel_errors(sim[mask], ctx.rp.measured[mask])
         rss = {ch: float(row @ row) for ch, row in zip(_CHANNELS, e, strict=True)}
         rms = {k: math.sqrt(v / n) for k, v in rss.items()}
