@@ -307,7 +307,12 @@ def render(doc: dict[str, Any]) -> str:
     failed = sum(s["failed"] for s in doc["summary"].values())
     if failed:
         lines += ["", f"{failed} identifications failed (see the JSON beside the figure)."]
-    lines += ["", f"Made by `python scripts/identify_mmg_records.py` in {doc['runtime_s']:.0f} s."]
+    simulator = doc.get("simulator", "shipgym")
+    flag = "" if simulator == "shipgym" else f" --simulator {simulator}"
+    lines += [
+        "",
+        f"Made by `python scripts/identify_mmg_records.py{flag}` in {doc['runtime_s']:.0f} s.",
+    ]
     return "\n".join(lines)
 
 
@@ -330,7 +335,8 @@ def plot(doc: dict[str, Any], path: Path) -> None:
     ax.set_yscale("log")
     ax.yaxis.set_major_formatter(ScalarFormatter())
     ax.set_ylabel("held-out heading RMS [deg]")
-    ax.set_title(f"{doc['model']} on MMG-made records: each seed before and after the loop")
+    made = SIMULATOR_NAMES[doc.get("simulator", "shipgym")]
+    ax.set_title(f"{doc['model']} on records of {made} MMG KVLCC2: each seed before and after")
     ax.legend(handles=[
         Line2D([], [], ls="", marker="o", mfc="white", mec="C0", label="before (base model)"),
         Line2D([], [], ls="", marker="o", color="C2", label="after, passed"),
