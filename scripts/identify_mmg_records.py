@@ -171,7 +171,7 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
             return a + rng.normal(0.0, MMG_NOISE[key], a.shape[0])
 
         u, v = noisy(u, "uv"), noisy(v, "uv")
-        meta = {k: v for k, v in rec.meta.items() if k != "truth"}
+        meta = {key: val for key, val in rec.meta.items() if key != "truth"}
         meta |= {"source": "shipmmg", "truth": {**truth, "simulator": "ShipMMG"}}
         out.append(Record(
             time=t, delta=noisy(rec.delta, "delta"), psi=noisy(psi, "psi"), r=noisy(r, "r"),
