@@ -139,7 +139,7 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
     channel, from its own seeded stream. Raises ``ImportError`` without ShipMMG.
     """
     from shipmmg.mmg_3dof import simulate
-    from shipmmg_compare import _shipmmg_params
+    from shipmmg_compare import shipmmg_params
 
     p = MMGParams.kvlcc2()
     rng = np.random.default_rng([seed, 1729])
@@ -157,7 +157,7 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
         psi0 = float(rec.psi[0])
         cs, sn = math.cos(psi0), math.sin(psi0)
         sol = simulate(
-            **_shipmmg_params(p), time_list=list(t), δ_list=list(felt),
+            **shipmmg_params(p), time_list=list(t), δ_list=list(felt),
             nps_list=list(rec.rpm / 60.0), u0=float(rec.u[0]) - v_n * cs - v_e * sn,
             v0=float(rec.v[0]) + v_n * sn - v_e * cs, r0=float(rec.r[0]), ψ0=psi0,
             ρ=p.rho, t_eval=t, rtol=1e-8, atol=1e-8,

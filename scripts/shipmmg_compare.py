@@ -51,7 +51,7 @@ VARIANTS = {
 }
 
 
-def _shipmmg_params(p: MMGParams) -> dict[str, float]:
+def shipmmg_params(p: MMGParams) -> dict[str, float]:
     """ShipMMG's keyword arguments for the ship ``p`` (dimensional as ShipMMG wants them)."""
     m_x, m_y, j_z = p.added_masses
     return dict(
@@ -74,7 +74,7 @@ def run_shipmmg(p: MMGParams, t: np.ndarray, delta: np.ndarray, n: float) -> np.
     from shipmmg.mmg_3dof import simulate
 
     sol = simulate(
-        **_shipmmg_params(p), time_list=list(t), δ_list=list(delta),
+        **shipmmg_params(p), time_list=list(t), δ_list=list(delta),
         nps_list=[n] * t.size, u0=KVLCC2_SIMMAN_SPEED, ρ=p.rho, t_eval=t, rtol=1e-9, atol=1e-9,
     )  # fmt: skip
     x, y, psi, dlt = sol.y[3:7]

@@ -1749,18 +1749,17 @@ class VMMAutoFamily(VMMFamily):
             with ThreadPoolExecutor(max_workers=2) as pool:
                 return dict(zip(names, pool.map(base, names), strict=True))
 
-        def ranking() -> list[str]:
-            return sorted(
-                (n for n, c in outcomes.items() if isinstance(c, Candidate)),
-                key=lambda n: outcomes[n].heldout_error,
-            )  # type: ignore[union-attr]
+        def ranked_finite(outcomes: Mapping[str, Candidate | Exception]) -> list[str]:
+            """The fitted structures with a finite held-out error, best first."""
+            fitted = {n: c for n, c in outcomes.items() if isinstance(c, Candidate)}
+            finite = [n for n in fitted if math.isfinite(fitted[n].heldout_error)]
+            return sorted(finite, key=lambda n: fitted[n].heldout_error)
 
         outcomes = fit(list(TERM_SETS))
-        tries = [n for n in ranking() if math.isfinite(outcomes[n].heldout_error)]  # type: ignore[union-attr]
-        outcomes |= fit([f"{n}+{e}" for n in tries[: self.ASYMMETRIC_TRIES]
-                         for e in STRUCTURE_EFFECTS])  # fmt: skip
+        best = ranked_finite(outcomes)[: self.ASYMMETRIC_TRIES]
+        outcomes |= fit([f"{n}+{e}" for n in best for e in STRUCTURE_EFFECTS])
         fitted = {n: c for n, c in outcomes.items() if isinstance(c, Candidate)}
-        ranked = ranking()
+        ranked = sorted(fitted, key=lambda n: fitted[n].heldout_error)
         if not ranked or not math.isfinite(fitted[ranked[0]].heldout_error):
             raise ValueError(f"no term set could be fitted and replayed: {outcomes}")
         for n in ranked:
