@@ -1,8 +1,15 @@
-"""Angle and input-check helpers of the controllers (no ``shipgym`` import).
+"""Angle, input-check and batch helpers of the controllers (no ``shipgym`` import).
 
 ``ssa`` is Fossen's smallest signed angle with the same semantics as ``shipgym.models.ssa``:
-``ssa(a) = ((a + pi) mod 2 pi) - pi``, in [-pi, pi). The controllers keep angles such as the
-reference heading *unwrapped* inside and wrap only differences (errors) with ``ssa``.
+``ssa(a) = ((a + pi) mod 2 pi) - pi``, in [-pi, pi); ``ssa_array`` is the same on arrays, bit for
+bit (NumPy's floor modulo and Python's ``%`` on floats are the same operation). The controllers
+keep angles such as the reference heading *unwrapped* inside and wrap only differences (errors).
+
+Batches: the autopilots keep their states as arrays of shape ``(n,)``, one entry per ship, and
+one ship is a batch of one (arrays of shape ``(1,)``) of the same code. :func:`batch_size`
+finds ``n`` from the arguments (``None``: numbers given, one ship in *scalar mode*),
+:func:`finite_batch` checks an argument, and :class:`BatchValue` reads a state back as a
+float in scalar mode and as an array for a batch.
 """
 
 from __future__ import annotations
@@ -16,6 +23,19 @@ import numpy.typing as npt
 TWO_PI = 2.0 * math.pi
 
 
+def constant(value: float) -> np.ndarray:
+    """``value`` as a 0-d float64 array.
+
+    The same number, but NumPy combines an array with a 0-d array about twice as fast as with
+    a Python float (no conversion of the scalar in every operation), which is most of the
+    cost of a small batch; the controllers keep their gains and limits in this form.
+    """
+    return np.array(value, dtype=np.float64)
+
+
+_PI, _TWO_PI, _ZERO = constant(math.pi), constant(TWO_PI), constant(0.0)
+
+
 def ssa(angle: float) -> float:
     """Smallest signed angle of a scalar: wrap ``angle`` [rad] to [-pi, pi)."""
     return (float(angle) + math.pi) % TWO_PI - math.pi
@@ -24,15 +44,16 @@ def ssa(angle: float) -> float:
 def ssa_array(angle: npt.ArrayLike) -> np.ndarray:
     """Smallest signed angle of every element of ``angle`` [rad], in [-pi, pi)."""
     a = np.asarray(angle, dtype=np.float64)
-    return np.mod(a + np.pi, TWO_PI) - np.pi
+    return np.mod(a + _PI, _TWO_PI) - _PI
 
 
-def unwrap_towards(reference: float, angle: float) -> float:
-    """The angle equal to ``angle`` modulo 2 pi that lies closest to ``reference`` [rad].
+def unwrap_towards(reference: npt.ArrayLike, angle: npt.ArrayLike) -> np.ndarray:
+    """The angles equal to ``angle`` modulo 2 pi that lie closest to ``reference`` [rad].
 
-    ``reference + ssa(angle - reference)``: a new heading setpoint is reached the short way.
+    ``reference + ssa(angle - reference)`` elementwise: a new heading setpoint is reached the
+    short way.
     """
-    return float(reference) + ssa(angle - reference)
+    return reference + ssa_array(np.subtract(angle, reference))
 
 
 def finite(name: str, value: Any) -> float:
@@ -67,6 +88,140 @@ def nonnegative(name: str, value: Any) -> float:
     if not (math.isfinite(f) and f >= 0):
         raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
     return f
+
+
+def batch_size(**values: Any) -> int | None:
+    """The number of ships ``n`` of arguments given together (keyword name -> value).
+
+    Numbers (and ``None``, an argument not given) say nothing; every 1-D argument must have
+    the same shape ``(n,)``. Returns ``None`` when no argument is an array: one ship, in scalar
+    mode.
+
+    Raises
+    ------
+    ValueError
+        For an argument with more than one dimension, or two 1-D arguments of different
+        lengths (the message names both and their shapes).
+    """
+    n: int | None = None
+    first = ""
+    for name, value in values.items():
+        if value is None:
+            continue
+        shape = np.shape(value)
+        if len(shape) > 1:
+            raise ValueError(
+                f"{name} must be a number or a 1-D array with one entry per ship, got shape {shape}"
+            )
+        if len(shape) == 1:
+            if n is None:
+                n, first = shape[0], name
+            elif shape[0] != n:
+                raise ValueError(
+                    f"{name} has shape {shape} but {first} has shape ({n},): one entry per ship "
+                    "expected in both"
+                )
+    return n
+
+
+def finite_batch(name: str, value: Any, n: int | None, *, broadcast: bool = True) -> np.ndarray:
+    """``value`` as a finite float64 array for a batch of ``n`` ships, or ``ValueError``.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name for the error message.
+    value : float or array_like
+        A number for one ship (``n`` ``None``: returned with shape ``(1,)``), an array of
+        shape ``(n,)`` for a batch, or a number for every ship of a batch (``broadcast``).
+    n : int or None
+        Ships in the batch; ``None`` for one ship in scalar mode.
+    broadcast : bool
+        Accept a number for every ship of a batch.
+
+    Raises
+    ------
+    ValueError
+        For a value that is not a finite number (naming the index of the first bad entry of
+        an array) or that has the wrong shape (naming its shape and the expected one).
+    """
+    if n is None:
+        if not isinstance(value, float | int) and np.ndim(value) != 0:
+            raise ValueError(
+                f"{name} has shape {np.shape(value)}, expected a number (shape ()): the "
+                "controller runs one ship since its last reset (reset it with arrays for a batch)"
+            )
+        return np.array([finite(name, value)])
+    try:
+        a = np.array(value, dtype=np.float64)  # a copy: the caller may change its array later
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be finite numbers, got {value!r}") from None
+    if a.shape != (n,):
+        if not (broadcast and a.ndim == 0):
+            kind = f"({n},) or a number" if broadcast else f"({n},)"
+            raise ValueError(
+                f"{name} has shape {a.shape}, expected {kind}: one entry per ship of the batch"
+            )
+        a = np.full(n, finite(name, a))
+    bad = ~np.isfinite(a)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{name}[{i}] must be a finite number, got {float(a[i])!r}")
+    return a
+
+
+def batch_value(values: np.ndarray, n: int | None) -> float | np.ndarray:
+    """A state read back: ``float(values[0])`` for one ship in scalar mode (``n`` ``None``),
+    a copy of ``values`` for a batch."""
+    return float(values[0]) if n is None else values.copy()
+
+
+class BatchValue:
+    """A read-only attribute over the ``(n,)`` array ``_<name>`` of its owner.
+
+    Reads as a float when the owner's ``batch_size`` is ``None`` (one ship, scalar mode) and as
+    a copy of the array for a batch (:func:`batch_value`).
+    """
+
+    def __init__(self, doc: str) -> None:
+        self.__doc__ = doc
+        self.name = self.private = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name, self.private = name, "_" + name
+
+    def __get__(self, obj: Any, objtype: type | None = None) -> Any:
+        if obj is None:
+            return self
+        return batch_value(getattr(obj, self.private), obj.batch_size)
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        raise AttributeError(f"{self.name} is read-only: it is a state of the controller")
+
+
+def bounds(lo: float, hi: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Bounds for :func:`clip`: 0-d arrays (:func:`constant`), ``None`` for an infinite one."""
+    return (None if lo == -math.inf else constant(lo)), (None if hi == math.inf else constant(hi))
+
+
+def clip(x: np.ndarray, lo: np.ndarray | None, hi: np.ndarray | None) -> np.ndarray:
+    """``min(max(x, lo), hi)`` elementwise with :func:`bounds`; a bound ``None`` (infinite) is
+    not applied (the same result for numbers), and without bounds ``x`` itself is returned."""
+    if lo is not None:
+        x = np.maximum(x, lo)
+        if hi is not None:
+            np.minimum(x, hi, out=x)
+    elif hi is not None:
+        x = np.minimum(x, hi)
+    return x
+
+
+def rate_limit(command: np.ndarray, previous: np.ndarray, step: float) -> np.ndarray:
+    """``command`` moved at most ``step`` from ``previous``, elementwise, where ``previous``
+    is a number (``nan``: no command yet, no limit)."""
+    step_ = constant(step)
+    limited = np.fmax(command, previous - step_)  # fmax and fmin ignore nan
+    return np.fmin(limited, previous + step_, out=limited)
 
 
 def optional_limit(name: str, value: Any) -> float:
@@ -142,27 +297,27 @@ def anti_windup_mode(value: str | bool) -> str:
 
 
 def integrate_with_anti_windup(
-    integral: float,
-    error: float,
+    integral: np.ndarray,
+    error: np.ndarray,
     h: float,
     ki: float,
-    excess: float,
+    excess: np.ndarray,
     mode: str,
     tracking_time: float,
-) -> float:
-    """One step of an error integral with anti-windup; returns the new integral.
+) -> np.ndarray:
+    """One step of error integrals with anti-windup, elementwise; returns the new integrals.
 
     Parameters
     ----------
-    integral : float
-        The integral so far; the control law adds ``ki * integral``.
-    error : float
-        Control error (setpoint minus measurement).
+    integral : numpy.ndarray
+        The integrals so far (one per ship); the control law adds ``ki * integral``.
+    error : numpy.ndarray
+        Control errors (setpoint minus measurement).
     h : float
         Step [s].
     ki : float
         Integral gain (either sign).
-    excess : float
+    excess : numpy.ndarray
         ``u - u_lim``: how far the unlimited command lies beyond the applied one (0 when no
         limit is active).
     mode : {"back_calculation", "conditional", "none"}
@@ -173,12 +328,15 @@ def integrate_with_anti_windup(
     tracking_time : float
         ``T_t`` [s] of the back-calculation.
     """
-    into_limit = excess != 0.0 and ki * error * excess > 0.0
-    if mode == "none" or not into_limit:
-        integral += error * h
-    if mode == "back_calculation" and ki != 0.0 and excess != 0.0:
-        integral -= excess / ki * -math.expm1(-h / tracking_time)
-    return integral
+    stepped = integral + error * constant(h)
+    if mode == "none":
+        return stepped
+    ki_ = constant(ki)
+    np.copyto(stepped, integral, where=ki_ * error * excess > _ZERO)  # limited, into the limit
+    if mode == "back_calculation" and ki != 0.0:
+        back = excess / ki_ * constant(-math.expm1(-h / tracking_time))
+        np.subtract(stepped, back, out=stepped, where=excess != _ZERO)
+    return stepped
 
 
 def tracking_time(kp: float, ki: float, kd: float = 0.0) -> float:
@@ -189,3 +347,43 @@ def tracking_time(kp: float, ki: float, kd: float = 0.0) -> float:
     td = abs(kd / kp) if kp != 0 else 0.0
     tt = math.sqrt(ti * td) if td > 0 else ti
     return tt if tt > 0 else 1.0
+
+
+def math_elementwise(func: Any, *args: np.ndarray) -> np.ndarray:
+    """``func`` of the :mod:`math` module applied to every element of equally shaped arrays.
+
+    Gives bitwise what the one-ship code gives with Python floats. NumPy's SIMD ``arctan``,
+    ``arctan2``, ``hypot`` and ``power`` round the last bit differently from :mod:`math` for a
+    small share of float64 inputs (measured on an AVX-512 machine: 1 ulp on 0.3 %, 2 %,
+    0.2 % and 0.1 % of random inputs); ``sin``, ``cos``, ``sqrt`` and ``mod`` agree exactly.
+    """
+    shape = args[0].shape
+    flat = [np.ravel(a).tolist() for a in args]
+    return np.fromiter(map(func, *flat), np.float64, count=len(flat[0])).reshape(shape)
+
+
+def batch_array(
+    name: str, value: Any, shape: tuple[int, ...], what: str, *, broadcast: bool = False
+) -> np.ndarray:
+    """``value`` as a finite float64 array of ``shape``, or ``ValueError`` naming ``name``.
+
+    ``broadcast``: ``shape`` is ``(n,)`` (one value per ship) and a single number is accepted
+    for every ship. ``what`` describes the expected values in the message, e.g.
+    ``"finite yaw rates [rad/s]"``.
+    """
+    if broadcast and isinstance(value, float | int) and math.isfinite(value):
+        return np.full(shape, float(value))
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be {what} of shape {shape}; got {value!r}") from None
+    if a.shape != shape:
+        if not (broadcast and a.size == 1 and a.ndim <= 1):
+            raise ValueError(f"{name} must be {what} of shape {shape}; got shape {a.shape}")
+        a = np.full(shape, a.item())
+    ok = np.isfinite(a)
+    if not np.logical_and.reduce(ok, axis=None):
+        i = tuple(int(j) for j in np.unravel_index(int(np.argmin(ok)), shape))
+        where = i[0] if len(i) == 1 else i
+        raise ValueError(f"{name} must be {what}; got {float(a[i])!r} at index {where}")
+    return a

@@ -57,6 +57,7 @@ __all__ = [
     "PodCommand",
     "allocate_force_moment",
     "azimuth_to_action",
+    "pod_env_actions",
     "pod_forces",
     "thrust_to_action",
 ]
@@ -194,6 +195,40 @@ def thrust_to_action(thrust: float, bollard_thrust: float = BOLLARD_THRUST) -> f
     return 2.0 * finite("thrust", thrust) / positive("bollard_thrust", bollard_thrust) - 1.0
 
 
+def pod_env_actions(
+    azimuth: npt.ArrayLike,
+    thrust: npt.ArrayLike,
+    env: EnvName = "path",
+    *,
+    max_azimuth: float = ENV_MAX_AZIMUTH,
+    bollard_thrust: float = BOLLARD_THRUST,
+    clip: bool = True,
+) -> np.ndarray:
+    """The normalised actions of a Gunnerus env that give common pod commands, one row per ship.
+
+    ``azimuth`` [rad] and ``thrust`` [N] are scalars or arrays of shape ``(n,)``
+    (broadcast together); the rows are those of :meth:`PodCommand.to_env_action` of each
+    ship's command. Returns a ``float32`` array of shape ``(n, 1)`` or ``(n, 2)``.
+    """
+    if env not in _ENVS:
+        raise ValueError(f"env must be one of {_ENVS}, got {env!r}")
+    az = np.atleast_1d(_finite_array("azimuth", azimuth)) / positive("max_azimuth", max_azimuth)
+    th = (
+        2.0 * np.atleast_1d(_finite_array("thrust", thrust))
+        / positive("bollard_thrust", bollard_thrust) - 1.0
+    )  # fmt: skip
+    az, th = np.broadcast_arrays(az, th)
+    if env == "heading":
+        out = az[:, None]
+    elif env == "speed":
+        out = th[:, None]
+    else:
+        out = np.stack([az, th], axis=1)
+    if clip:
+        out = np.clip(out, -1.0, 1.0)
+    return out.astype(np.float32)
+
+
 @dataclass(frozen=True)
 class PodCommand:
     """A common command to both Gunnerus pods in physical units.
@@ -250,20 +285,10 @@ class PodCommand:
         numpy.ndarray
             ``float32`` action of shape ``(1,)`` or ``(2,)``.
         """
-        az = azimuth_to_action(self.azimuth, max_azimuth)
-        th = thrust_to_action(self.thrust, bollard_thrust)
-        if env == "heading":
-            a = [az]
-        elif env == "speed":
-            a = [th]
-        elif env in ("path", "target"):
-            a = [az, th]
-        else:
-            raise ValueError(f"env must be one of {_ENVS}, got {env!r}")
-        out = np.array(a, dtype=np.float64)
-        if clip:
-            out = np.clip(out, -1.0, 1.0)
-        return out.astype(np.float32)
+        return pod_env_actions(
+            self.azimuth, self.thrust, env, max_azimuth=max_azimuth,
+            bollard_thrust=bollard_thrust, clip=clip,
+        )[0]  # fmt: skip
 
     @classmethod
     def from_env_action(

@@ -68,6 +68,13 @@ directionally unstable ship (R/V Gunnerus) from being asked for a turn rate it c
 Angles are unwrapped inside: a new setpoint is reached the short way (relative to the
 previous setpoint).
 
+Batches: :class:`HeadingAutopilot` and :class:`HeadingReferenceModel` run a batch of ships
+with the same gains and limits. Their states are arrays ``(n,)``, one entry per ship, and one
+ship is a batch of one of the same code: reset with numbers, they take numbers and return
+floats; reset with arrays ``(n,)``, they take and return arrays. Every operation is
+elementwise in the order of the scalar law above, so each ship of a batch gets, bit for bit,
+the numbers it gets alone.
+
 R/V Gunnerus (shipgym ``rvg3dof`` at 5.14 m/s, azimuth of both pods as the command): the
 linearised sway-yaw model has an unstable pole at +0.18 1/s and an initial yaw acceleration
 of -0.0137 rad/s^2 per rad of azimuth, i.e. ``T = -5.57 s`` and ``K = 0.076 1/s``
@@ -86,16 +93,25 @@ from typing import Literal
 
 import control
 import numpy as np
+from numpy.typing import ArrayLike
 
 from controllers._angles import (
+    BatchValue,
     StepClock,
     anti_windup_mode,
+    batch_size,
+    batch_value,
+    bounds,
+    clip,
+    constant,
     finite,
+    finite_batch,
     integrate_with_anti_windup,
     nonnegative,
     optional_limit,
     positive,
-    ssa,
+    rate_limit,
+    ssa_array,
     tracking_time,
     unwrap_towards,
 )
@@ -471,7 +487,8 @@ class HeadingDesignReport:
 
 
 class HeadingReferenceModel:
-    """Third-order heading reference model with rate and acceleration limits.
+    """Third-order heading reference model with rate and acceleration limits, for one ship or
+    a batch of ships.
 
     Parameters
     ----------
@@ -486,9 +503,22 @@ class HeadingReferenceModel:
 
     Attributes
     ----------
-    psi_d, r_d, a_d : float
-        Desired heading [rad, unwrapped], yaw rate [rad/s] and yaw acceleration [rad/s^2].
+    psi_d, r_d, a_d : float or numpy.ndarray
+        Desired heading [rad, unwrapped], yaw rate [rad/s] and yaw acceleration [rad/s^2]:
+        floats for one ship (reset with numbers), arrays ``(n,)`` for a batch.
+    psi_f : float or numpy.ndarray
+        The low-pass-filtered setpoint [rad, unwrapped].
+    psi_ref : float or numpy.ndarray
+        The last setpoint [rad], unwrapped next to the one before.
+    batch_size : int or None
+        Ships in the batch; ``None`` for one ship (scalar mode).
     """
+
+    psi_d = BatchValue("Desired heading [rad, unwrapped].")
+    r_d = BatchValue("Desired yaw rate [rad/s].")
+    a_d = BatchValue("Desired yaw acceleration [rad/s^2].")
+    psi_f = BatchValue("Low-pass-filtered setpoint [rad, unwrapped].")
+    psi_ref = BatchValue("Last setpoint [rad, unwrapped next to the one before].")
 
     def __init__(
         self,
@@ -504,41 +534,59 @@ class HeadingReferenceModel:
         self.max_turn_accel = optional_limit("max_turn_accel", max_turn_accel)
         self.reset(0.0)
 
-    def reset(self, psi: float, r: float = 0.0) -> None:
-        """Start at heading ``psi`` [rad] turning at ``r`` [rad/s] (clipped to the rate limit)."""
-        psi = finite("psi", psi)
-        self.psi_d = psi
-        self.psi_f = psi
-        self.psi_ref = psi
-        self.r_d = float(np.clip(finite("r", r), -self.max_turn_rate, self.max_turn_rate))
-        self.a_d = 0.0
+    def reset(self, psi: ArrayLike, r: ArrayLike = 0.0) -> None:
+        """Start at heading ``psi`` [rad] turning at ``r`` [rad/s] (clipped to the rate limit).
 
-    def update(self, psi_ref: float, h: float) -> tuple[float, float, float]:
+        Numbers start one ship (scalar mode); arrays of shape ``(n,)`` a batch of ``n`` ships
+        (a number for ``r`` is then every ship's).
+        """
+        n = batch_size(psi=psi, r=r)
+        self._start(finite_batch("psi", psi, n), finite_batch("r", r, n), n)
+
+    def _start(self, psi: np.ndarray, r: np.ndarray, n: int | None) -> None:
+        """:meth:`reset` with checked ``(n,)`` arrays (``(1,)`` and ``n = None``: one ship)."""
+        self.batch_size = n
+        self._psi_d = self._psi_f = self._psi_ref = psi
+        self._r_d = clip(r, *bounds(-self.max_turn_rate, self.max_turn_rate))
+        self._a_d = np.zeros(psi.shape)
+
+    def update(
+        self, psi_ref: ArrayLike, h: float
+    ) -> tuple[float | np.ndarray, float | np.ndarray, float | np.ndarray]:
         """Advance ``h`` seconds towards ``psi_ref`` [rad]; return ``(psi_d, r_d, a_d)``.
 
         ``psi_ref`` is unwrapped next to the previous setpoint, so the model turns the short
-        way; ``psi_d`` is returned unwrapped (wrap it with ``ssa`` for display).
+        way; ``psi_d`` is returned unwrapped (wrap it with ``ssa`` for display). For a batch,
+        ``psi_ref`` is an array ``(n,)`` or one setpoint for all, and the results are arrays.
         """
-        self.psi_ref = unwrap_towards(self.psi_ref, finite("psi_ref", psi_ref))
-        h = nonnegative("h", h)
+        ref = finite_batch("psi_ref", psi_ref, self.batch_size)
+        psi_d, r_d, a_d = self._advance(ref, nonnegative("h", h))
+        n = self.batch_size
+        return batch_value(psi_d, n), batch_value(r_d, n), batch_value(a_d, n)
+
+    def _advance(self, psi_ref: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`update` with a checked setpoint array; returns the new state arrays."""
+        self._psi_ref = ref = unwrap_towards(self._psi_ref, psi_ref)
         w, z = self.omega, self.zeta
         rmax, amax = self.max_turn_rate, self.max_turn_accel
         n = max(1, math.ceil(h * w / _REF_SUBSTEP))
         hs = h / n
-        decay = math.exp(-w * hs)
-        psi_d, r_d, psi_f, ref = self.psi_d, self.r_d, self.psi_f, self.psi_ref
-        w2, c = w * w, 2.0 * z * w
+        # the numbers of the law as 0-d arrays (faster with small batches, the same values)
+        decay, half_step = constant(math.exp(-w * hs)), constant(0.5 * hs)
+        w2, c, hs = constant(w * w), constant(2.0 * z * w), constant(hs)
+        rate, accel = bounds(-rmax, rmax), bounds(-amax, amax)
+        psi_d, r_d, psi_f = self._psi_d, self._r_d, self._psi_f
         for _ in range(n):  # Heun's method (2nd order); psi_f is integrated exactly
-            a1 = min(max(w2 * (psi_f - psi_d) - c * r_d, -amax), amax)
+            a1 = clip(w2 * (psi_f - psi_d) - c * r_d, *accel)
             psi_f = ref + (psi_f - ref) * decay
-            r_p = min(max(r_d + hs * a1, -rmax), rmax)
-            a2 = min(max(w2 * (psi_f - psi_d - hs * r_d) - c * r_p, -amax), amax)
-            psi_d += 0.5 * hs * (r_d + r_p)
-            r_d = min(max(r_d + 0.5 * hs * (a1 + a2), -rmax), rmax)
-        a = min(max(w2 * (psi_f - psi_d) - c * r_d, -amax), amax)
-        if abs(r_d) >= rmax and a * r_d > 0:
-            a = 0.0  # held at the rate limit
-        self.psi_d, self.r_d, self.psi_f, self.a_d = psi_d, r_d, psi_f, a
+            r_p = clip(r_d + hs * a1, *rate)
+            a2 = clip(w2 * (psi_f - psi_d - hs * r_d) - c * r_p, *accel)
+            psi_d = psi_d + half_step * (r_d + r_p)
+            r_d = clip(r_d + half_step * (a1 + a2), *rate)
+        a = clip(w2 * (psi_f - psi_d) - c * r_d, *accel)
+        if rate[1] is not None:  # held at the rate limit
+            np.copyto(a, 0.0, where=(np.abs(r_d) >= rate[1]) & (a * r_d > 0.0))
+        self._psi_d, self._r_d, self._psi_f, self._a_d = psi_d, r_d, psi_f, a
         return psi_d, r_d, a
 
     def transfer_function(self) -> control.TransferFunction:
@@ -548,7 +596,8 @@ class HeadingReferenceModel:
 
 
 class HeadingAutopilot:
-    """PID heading autopilot tracking a reference model (module docstring for the equations).
+    """PID heading autopilot tracking a reference model (module docstring for the equations),
+    for one ship or a batch of ships with the same gains and limits.
 
     Parameters
     ----------
@@ -587,17 +636,39 @@ class HeadingAutopilot:
 
     Attributes
     ----------
-    psi_d, r_d, a_d : float
+    psi_d, r_d, a_d : float or numpy.ndarray
         Last reference heading [rad, wrapped to [-pi, pi)], yaw rate, acceleration.
-    error : float
+    error : float or numpy.ndarray
         Last heading error ``ssa(psi_d - psi)`` [rad].
-    integral : float
+    integral : float or numpy.ndarray
         Heading-error integral [rad s]; the integral term is ``ki * integral``.
-    command : float
-        Last command (rad, or the plant's input unit) after the limits.
-    unsaturated_command : float
+    command : float or numpy.ndarray
+        Last command (rad, or the plant's input unit) after the limits (``nan`` before the
+        first command when :meth:`reset` got none).
+    unsaturated_command : float or numpy.ndarray
         Last command before the limits.
+    offset : float or numpy.ndarray
+        The command offset ``b0``; one per ship after ``reset(..., keep_offset=True)`` of a
+        batch.
+    batch_size : int or None
+        Ships in the batch; ``None`` for one ship (scalar mode).
+
+    Notes
+    -----
+    The states are arrays of shape ``(n,)``, one entry per ship; one ship is a batch of one
+    of the same code. :meth:`reset` with numbers (scalar mode) makes the states read as floats
+    and :meth:`update` take numbers and return a float; :meth:`reset` with arrays of shape
+    ``(n,)`` makes them read as arrays and :meth:`update` take and return arrays. Each ship of
+    a batch gets exactly the numbers it would get alone.
     """
+
+    psi_d = BatchValue("Last reference heading [rad, wrapped to [-pi, pi)].")
+    r_d = BatchValue("Last reference yaw rate [rad/s].")
+    a_d = BatchValue("Last reference yaw acceleration [rad/s^2].")
+    error = BatchValue("Last heading error ``ssa(psi_d - psi)`` [rad].")
+    integral = BatchValue("Heading-error integral [rad s].")
+    command = BatchValue("Last command after the limits.")
+    unsaturated_command = BatchValue("Last command before the limits.")
 
     def __init__(
         self,
@@ -764,112 +835,152 @@ class HeadingAutopilot:
     # ------------------------------------------------------------------------------------
     def reset(
         self,
-        psi: float,
-        r: float = 0.0,
+        psi: ArrayLike,
+        r: ArrayLike = 0.0,
         *,
         t: float | None = None,
-        command: float | None = None,
+        command: ArrayLike | None = None,
         keep_offset: bool = False,
     ) -> None:
         """Restart at heading ``psi`` [rad] and yaw rate ``r`` [rad/s].
 
+        Numbers restart one ship (scalar mode); arrays of shape ``(n,)`` a batch of ``n``
+        ships (a number for ``r`` or ``command`` is then every ship's).
+
         Parameters
         ----------
-        psi, r : float
+        psi, r : float or array_like
             Measured heading and yaw rate; the reference model starts there.
         t : float, optional
-            Time [s] of this state; the next :meth:`update` integrates from it.
-        command : float, optional
+            Time [s] of this state (one for the batch); the next :meth:`update` integrates
+            from it.
+        command : float or array_like, optional
             The actuator's present command, the start of the rate limiter; without it
             the first command is not rate limited.
         keep_offset : bool
             Move the integral term into the offset (``b0 += ki * integral``) instead of
-            forgetting it: the learned rudder offset is kept for the next manoeuvre.
+            forgetting it: the learned rudder offset is kept for the next manoeuvre (for a
+            batch, one offset per ship, and the batch must keep its size).
+
+        Raises
+        ------
+        ValueError
+            For a value that is not finite (an array names the index of the first bad
+            entry), arrays of different lengths, or a batch size that does not match the
+            offsets kept per ship.
         """
-        psi = finite("psi", psi)
-        r = finite("r", r)
+        n = batch_size(psi=psi, r=r, command=command)
+        psi_a = finite_batch("psi", psi, n)
+        r_a = finite_batch("r", r, n)
+        cmd = np.full(psi_a.shape, math.nan)
+        if command is not None:
+            cmd = finite_batch("command", command, n)
+        offset = self.offset
         if keep_offset:
-            self.offset += self.ki * getattr(self, "integral", 0.0)
-        self.integral = 0.0
+            offset = offset + self.ki * self._integral
+        if np.ndim(offset) != 0 and np.shape(offset) != psi_a.shape:
+            raise ValueError(
+                f"offset has shape {np.shape(offset)} (one per ship, kept by keep_offset=True) "
+                f"but the reset is for shape {psi_a.shape}; set offset to a number to start a "
+                "batch of another size"
+            )
+        if keep_offset:
+            self.offset = float(offset[0]) if n is None else offset
+        self._integral = np.zeros(psi_a.shape)
         if self.reference is not None:
-            self.reference.reset(psi, r)
-            self.psi_d, self.r_d, self.a_d = ssa(psi), self.reference.r_d, 0.0
+            self.reference._start(psi_a, r_a, n)
+            self._r_d = self.reference._r_d
         else:
-            self.psi_d, self.r_d, self.a_d = ssa(psi), 0.0, 0.0
-        self.error = 0.0
-        self.command = math.nan if command is None else finite("command", command)
-        self.unsaturated_command = self.command
+            self._r_d = np.zeros(psi_a.shape)
+        self._psi_d = ssa_array(psi_a)
+        self._a_d = self._error = np.zeros(psi_a.shape)
+        self._command = self._unsaturated_command = cmd
         self._clock.reset(t)
+        self.batch_size = n
         self._initialised = True
 
     @property
-    def offset_estimate(self) -> float:
-        """Estimated constant command offset: ``b0 + ki * integral``.
+    def offset_estimate(self) -> float | np.ndarray:
+        """Estimated constant command offset: ``b0 + ki * integral`` (one per ship).
 
         At a steady straight course the integral term settles at whatever constant command
         the disturbances (rudder bias, current, wind) require; this is that estimate.
         """
-        return self.offset + self.ki * self.integral
+        return batch_value(self.offset + self.ki * self._integral, self.batch_size)
 
-    def update(self, t: float | None, psi: float, r: float, psi_ref: float) -> float:
+    def update(
+        self, t: float | None, psi: ArrayLike, r: ArrayLike, psi_ref: ArrayLike
+    ) -> float | np.ndarray:
         """One controller step; returns the steering command.
 
         Parameters
         ----------
         t : float or None
-            Sample time [s]; the step is the difference to the previous ``t`` (``dt`` when
-            ``None``). The first call after construction resets at the measured state.
-        psi : float
-            Measured heading [rad] (any wrapping).
-        r : float
-            Measured yaw rate [rad/s].
-        psi_ref : float
-            Heading setpoint [rad] (any wrapping; reached the short way).
+            Sample time [s] of the whole batch; the step is the difference to the previous
+            ``t`` (``dt`` when ``None``). The first call after construction resets at the
+            measured state (and takes the batch size from ``psi``).
+        psi : float or array_like
+            Measured heading [rad] (any wrapping): a number for one ship, an array ``(n,)``
+            for a batch.
+        r : float or array_like
+            Measured yaw rate [rad/s], as ``psi``.
+        psi_ref : float or array_like
+            Heading setpoint [rad] (any wrapping; reached the short way); for a batch an
+            array ``(n,)`` or one setpoint for every ship.
 
         Returns
         -------
-        float
+        float or numpy.ndarray
             Steering command (rad for a rudder or azimuth) within ``max_command`` and the
-            rate limit.
+            rate limit: a float for one ship, an array ``(n,)`` for a batch.
+
+        Raises
+        ------
+        ValueError
+            For a value that is not finite (an array names the index), a shape that is not
+            the batch's (naming both shapes), or a time that goes backwards.
         """
-        psi = finite("psi", psi)
-        r = finite("r", r)
-        psi_ref = finite("psi_ref", psi_ref)
+        n = self.batch_size if self._initialised else batch_size(psi=psi, r=r, psi_ref=psi_ref)
+        psi_a = finite_batch("psi", psi, n, broadcast=False)
+        r_a = finite_batch("r", r, n, broadcast=False)
+        ref = finite_batch("psi_ref", psi_ref, n)
         if not self._initialised:
             self.reset(psi, r)
         h = self._clock.step(t)
         if self.reference is not None:
-            psi_d, r_d, a_d = self.reference.update(psi_ref, h)
+            psi_d, r_d, a_d = self.reference._advance(ref, h)
         else:
-            psi_d, r_d, a_d = psi_ref, 0.0, 0.0
-        e = ssa(psi_d - psi)
-        heading_part = self.kp * e + self.ki * self.integral
-        u = heading_part - self.kd * (r - r_d) + self.offset
+            psi_d, r_d, a_d = ref, self._r_d, self._a_d  # r_d = a_d = 0
+        # the gains as 0-d arrays (faster with small batches, the same values)
+        kp, ki, kd, offset = constant(self.kp), constant(self.ki), constant(self.kd), self.offset
+        offset = np.asarray(offset, dtype=np.float64)
+        e = ssa_array(psi_d - psi_a)
+        heading_part = kp * e + ki * self._integral
+        u = heading_part - kd * (r_a - r_d) + offset
         u_applied = u
         if math.isfinite(self.max_turn_rate) and self.kd != 0.0:
             # The PID as a cascade: u = -Kd (r - r_cmd) + b0 with the yaw-rate demand
             # r_cmd = r_d + (Kp e + Ki int e) / Kd. Clipping r_cmd keeps a large heading
             # error from asking for a turn the ship cannot check (an unstable ship).
-            r_cmd = r_d + heading_part / self.kd
-            r_lim = min(max(r_cmd, -self.max_turn_rate), self.max_turn_rate)
-            u_applied = -self.kd * (r - r_lim) + self.offset
+            r_cmd = r_d + heading_part / kd
+            r_lim = clip(r_cmd, *bounds(-self.max_turn_rate, self.max_turn_rate))
+            u_applied = constant(-self.kd) * (r_a - r_lim) + offset
         if self.nomoto_feedforward and self.nomoto is not None:
-            K, T = self.nomoto
+            K, T = constant(self.nomoto[0]), constant(self.nomoto[1])
             feedforward = (T * a_d + r_d) / K
-            u += feedforward
-            u_applied += feedforward
-        u_lim = min(max(u_applied, -self.max_command), self.max_command)
-        if math.isfinite(self.max_rate) and math.isfinite(self.command):
-            step = self.max_rate * h
-            u_lim = min(max(u_lim, self.command - step), self.command + step)
-        self.integral = integrate_with_anti_windup(
-            self.integral, e, h, self.ki, u - u_lim, self.anti_windup, self.tracking_time
+            u = u + feedforward
+            u_applied = u_applied + feedforward
+        u_lim = clip(u_applied, *bounds(-self.max_command, self.max_command))
+        if math.isfinite(self.max_rate):
+            u_lim = rate_limit(u_lim, self._command, self.max_rate * h)
+        self._integral = integrate_with_anti_windup(
+            self._integral, e, h, self.ki, u - u_lim, self.anti_windup, self.tracking_time
         )
-        self.psi_d, self.r_d, self.a_d = ssa(psi_d), r_d, a_d
-        self.error = e
-        self.unsaturated_command = u
-        self.command = u_lim
-        return u_lim
+        self._psi_d, self._r_d, self._a_d = ssa_array(psi_d), r_d, a_d
+        self._error = e
+        self._unsaturated_command = u
+        self._command = u_lim
+        return batch_value(u_lim, n)
 
     # ------------------------------------------------------------------------------------
     def design_report(

@@ -11,6 +11,11 @@ thrust limit ``T_bollard (1 - u_r / u_0)`` of the Gunnerus pods) and optionally 
 feed-forward the PI only has to remove the transient and model errors. Anti-windup as in the
 heading autopilot (back-calculation by default; ``controllers._angles``).
 
+The autopilot runs a batch of ships with the same gains and limits: its states are arrays
+``(n,)``, one entry per ship, and one ship is a batch of one of the same code (numbers in,
+a float out). The feed-forward and a speed-dependent limit are then called with arrays, so
+they must work elementwise (the functions below do).
+
 Feed-forward models (no ``shipgym`` import: give numbers or a callable):
 
 * quadratic drag (Gunnerus, seed 001 eq. 15 in calm water with ``v = r = 0``):
@@ -33,14 +38,25 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+import numpy as np
+from numpy.typing import ArrayLike
+
 from controllers._angles import (
+    BatchValue,
     StepClock,
     anti_windup_mode,
+    batch_size,
+    batch_value,
+    bounds,
+    clip,
+    constant,
     finite,
+    finite_batch,
     integrate_with_anti_windup,
     nonnegative,
     optional_limit,
     positive,
+    rate_limit,
     tracking_time,
 )
 
@@ -51,13 +67,14 @@ __all__ = [
     "quadratic_drag_feedforward",
 ]
 
-Limit = float | Callable[[float], float] | None
+#: A function of the speed [m/s], a float or an array of speeds (one per ship) to as many values.
+SpeedFunction = Callable[[ArrayLike], ArrayLike]
+Limit = float | SpeedFunction | None
 
 
-def quadratic_drag_feedforward(
-    d1: float, d2: float = 0.0, *, share: float = 1.0
-) -> Callable[[float], float]:
-    """Feed-forward ``c_ff(u) = share (d1 u + d2 u|u|)``: the force that balances the drag.
+def quadratic_drag_feedforward(d1: float, d2: float = 0.0, *, share: float = 1.0) -> SpeedFunction:
+    """Feed-forward ``c_ff(u) = share (d1 u + d2 u|u|)``: the force that balances the drag
+    (elementwise for an array of speeds).
 
     Parameters
     ----------
@@ -73,14 +90,15 @@ def quadratic_drag_feedforward(
     d2 = nonnegative("d2", d2)
     share = positive("share", share)
 
-    def feedforward(u: float) -> float:
+    def feedforward(u: ArrayLike) -> ArrayLike:
         return share * (d1 * u + d2 * u * abs(u))
 
     return feedforward
 
 
-def linear_feedforward(gain: float) -> Callable[[float], float]:
-    """Feed-forward ``c_ff(u) = u / gain`` of a linear steady relation ``u = gain * c``.
+def linear_feedforward(gain: float) -> SpeedFunction:
+    """Feed-forward ``c_ff(u) = u / gain`` of a linear steady relation ``u = gain * c``
+    (elementwise for an array of speeds).
 
     For the Nomoto-family surge model ``U' = (K_u n - U) / T_u`` the gain is ``K_u`` [m/s per
     rev/s] and the command is the shaft speed ``n`` [rev/s].
@@ -89,7 +107,7 @@ def linear_feedforward(gain: float) -> Callable[[float], float]:
     if gain == 0:
         raise ValueError("feed-forward gain must be non-zero, got 0")
 
-    def feedforward(u: float) -> float:
+    def feedforward(u: ArrayLike) -> ArrayLike:
         return u / gain
 
     return feedforward
@@ -128,7 +146,8 @@ def linearised_drag_model(
 
 
 class SpeedAutopilot:
-    """PI speed autopilot with feed-forward, limits and anti-windup (module docstring).
+    """PI speed autopilot with feed-forward, limits and anti-windup (module docstring), for
+    one ship or a batch of ships with the same gains and limits.
 
     Parameters
     ----------
@@ -139,12 +158,13 @@ class SpeedAutopilot:
     dt : float
         Nominal sample time [s] (used when :meth:`update` gets ``t=None``).
     feedforward : callable, optional
-        ``c_ff(u_ref)``: the steady command for a speed; none by default.
+        ``c_ff(u_ref)``: the steady command for a speed; none by default. Called with a
+        float for one ship and with an array ``(n,)`` for a batch (elementwise).
     min_command : float
         Lower command limit (``-inf`` by default; 0 for thrust that cannot reverse).
     max_command : float or callable, optional
         Upper command limit, a number or a function of the measured speed ``u`` (e.g. a
-        thrust limit that falls with speed); none by default.
+        thrust limit that falls with speed; called as ``feedforward`` is); none by default.
     max_rate : float, optional
         Command rate limit [command/s].
     anti_windup : {"back_calculation", "conditional", "none"} or bool
@@ -152,10 +172,26 @@ class SpeedAutopilot:
 
     Attributes
     ----------
-    error, integral, command, unsaturated_command, feedforward_command : float
+    error, integral, command, unsaturated_command, feedforward_command : float or ndarray
         Last speed error [m/s], error integral [m], applied and unlimited command, and the
-        feed-forward part.
+        feed-forward part: floats for one ship, arrays ``(n,)`` for a batch.
+    batch_size : int or None
+        Ships in the batch; ``None`` for one ship (scalar mode).
+
+    Notes
+    -----
+    The states are arrays of shape ``(n,)``; one ship is a batch of one of the same code.
+    :meth:`reset` with arrays (``integral`` or ``command``) starts a batch; a reset with
+    numbers leaves the choice to the next :meth:`update`: numbers run one ship (scalar mode,
+    a float returned), arrays ``(n,)`` a batch of ``n`` (the reset's numbers are every
+    ship's). Each ship of a batch gets exactly the numbers it would get alone.
     """
+
+    error = BatchValue("Last speed error [m/s].")
+    integral = BatchValue("Speed-error integral [m].")
+    command = BatchValue("Last command after the limits.")
+    unsaturated_command = BatchValue("Last command before the limits.")
+    feedforward_command = BatchValue("Last feed-forward part of the command.")
 
     def __init__(
         self,
@@ -163,7 +199,7 @@ class SpeedAutopilot:
         ki: float,
         dt: float,
         *,
-        feedforward: Callable[[float], float] | None = None,
+        feedforward: SpeedFunction | None = None,
         min_command: float = -math.inf,
         max_command: Limit = None,
         max_rate: float | None = None,
@@ -183,7 +219,7 @@ class SpeedAutopilot:
         if math.isnan(self.min_command) or self.min_command == math.inf:
             raise ValueError(f"min_command must be a number or -inf, got {min_command!r}")
         if max_command is None:
-            self._max: float | Callable[[float], float] = math.inf
+            self._max: float | SpeedFunction = math.inf
         elif callable(max_command):
             self._max = max_command
         else:
@@ -208,7 +244,7 @@ class SpeedAutopilot:
         *,
         omega_n: float,
         zeta: float = 1.0,
-        feedforward: Callable[[float], float] | None = None,
+        feedforward: SpeedFunction | None = None,
         min_command: float = -math.inf,
         max_command: Limit = None,
         max_rate: float | None = None,
@@ -248,71 +284,110 @@ class SpeedAutopilot:
             anti_windup=anti_windup,
         )
 
-    def max_command(self, u: float) -> float:
-        """Upper command limit at measured speed ``u`` [m/s]."""
-        if callable(self._max):
+    def max_command(self, u: ArrayLike) -> float | np.ndarray:
+        """Upper command limit at measured speed ``u`` [m/s]: a float for a number, an array
+        for an array of speeds (unless the limit is a constant)."""
+        if not callable(self._max):
+            return self._max
+        if np.ndim(u) == 0:
             return float(self._max(u))
-        return self._max
+        return np.asarray(self._max(u), dtype=np.float64)
 
     def reset(
-        self, *, t: float | None = None, command: float | None = None, integral: float = 0.0
+        self,
+        *,
+        t: float | None = None,
+        integral: ArrayLike = 0.0,
+        command: ArrayLike | None = None,
     ) -> None:
         """Restart: clear the integral (or set it), the rate limiter and the clock.
 
         Parameters
         ----------
         t : float, optional
-            Time [s] of the restart; the next :meth:`update` integrates from it.
-        command : float, optional
-            The actuator's present command, the start of the rate limiter.
-        integral : float
-            Initial error integral [m].
+            Time [s] of the restart (one for the batch); the next :meth:`update` integrates
+            from it.
+        integral : float or array_like
+            Initial error integral [m]: a number, or one per ship (an array ``(n,)``, which
+            starts a batch of ``n``).
+        command : float or array_like, optional
+            The actuator's present command, the start of the rate limiter (a number, or one
+            per ship).
+
+        Raises
+        ------
+        ValueError
+            For a value that is not finite (an array names the index of the first bad
+            entry) or arrays of different lengths.
         """
-        self.integral = finite("integral", integral)
-        self.error = 0.0
-        self.command = math.nan if command is None else finite("command", command)
-        self.unsaturated_command = self.command
-        self.feedforward_command = 0.0
+        n = batch_size(integral=integral, command=command)
+        self._integral = finite_batch("integral", integral, n)
+        shape = self._integral.shape
+        self._command = np.full(shape, math.nan)
+        if command is not None:
+            self._command = finite_batch("command", command, n)
+        self._unsaturated_command = self._command
+        self._error = self._feedforward_command = np.zeros(shape)
         self._clock.reset(t)
+        self.batch_size = n
+        #: a reset with numbers leaves one ship or a batch to the next update
+        self._size_open = n is None
         self._initialised = True
 
-    def update(self, t: float | None, u: float, u_ref: float) -> float:
+    def update(self, t: float | None, u: ArrayLike, u_ref: ArrayLike) -> float | np.ndarray:
         """One controller step; returns the command.
 
         Parameters
         ----------
         t : float or None
-            Sample time [s]; the step is the difference to the previous ``t``.
-        u : float
-            Measured speed [m/s] (surge speed through the water, or over ground).
-        u_ref : float
-            Speed setpoint [m/s].
+            Sample time [s] of the whole batch; the step is the difference to the previous
+            ``t``.
+        u : float or array_like
+            Measured speed [m/s] (surge speed through the water, or over ground): a number
+            for one ship, an array ``(n,)`` for a batch.
+        u_ref : float or array_like
+            Speed setpoint [m/s]; for a batch an array ``(n,)`` or one setpoint for all.
 
         Returns
         -------
-        float
-            Command within the limits.
+        float or numpy.ndarray
+            Command within the limits: a float for one ship, an array ``(n,)`` for a batch.
+
+        Raises
+        ------
+        ValueError
+            For a value that is not finite (an array names the index), a shape that is not
+            the batch's (naming both shapes), a feed-forward that returns a value that is
+            not finite, or a time that goes backwards.
         """
-        u = finite("u", u)
-        u_ref = finite("u_ref", u_ref)
         if not self._initialised:
             self.reset()
+        n = batch_size(u=u, u_ref=u_ref) if self._size_open else self.batch_size
+        u_a = finite_batch("u", u, n, broadcast=False)
+        u_ref_a = finite_batch("u_ref", u_ref, n)
+        if self._size_open:
+            if n is not None:  # the reset's numbers become every ship's
+                self._integral = np.full(n, self._integral[0])
+                self._command = self._unsaturated_command = np.full(n, self._command[0])
+                self._error = self._feedforward_command = np.zeros(n)
+            self.batch_size, self._size_open = n, False
         h = self._clock.step(t)
-        e = u_ref - u
-        ff = 0.0 if self.feedforward is None else float(self.feedforward(u_ref))
-        if not math.isfinite(ff):
-            raise ValueError(f"feedforward({u_ref!r}) returned {ff!r}, expected a finite number")
-        c = ff + self.kp * e + self.ki * self.integral
-        hi = self.max_command(u)
-        c_lim = min(max(c, self.min_command), max(hi, self.min_command))
-        if math.isfinite(self.max_rate) and math.isfinite(self.command):
-            step = self.max_rate * h
-            c_lim = min(max(c_lim, self.command - step), self.command + step)
-        self.integral = integrate_with_anti_windup(
-            self.integral, e, h, self.ki, c - c_lim, self.anti_windup, self.tracking_time
+        e = u_ref_a - u_a
+        ff = np.zeros(e.shape)
+        if self.feedforward is not None:
+            speed = batch_value(u_ref_a, n)
+            name = "feedforward(u_ref)" if n is not None else f"feedforward({speed!r})"
+            ff = finite_batch(name, self.feedforward(speed), n)
+        c = ff + constant(self.kp) * e + constant(self.ki) * self._integral
+        hi = np.maximum(self.max_command(batch_value(u_a, n)), self.min_command)
+        c_lim = np.minimum(clip(c, *bounds(self.min_command, math.inf)), hi)
+        if math.isfinite(self.max_rate):
+            c_lim = rate_limit(c_lim, self._command, self.max_rate * h)
+        self._integral = integrate_with_anti_windup(
+            self._integral, e, h, self.ki, c - c_lim, self.anti_windup, self.tracking_time
         )
-        self.error = e
-        self.feedforward_command = ff
-        self.unsaturated_command = c
-        self.command = c_lim
-        return c_lim
+        self._error = e
+        self._feedforward_command = ff
+        self._unsaturated_command = c
+        self._command = c_lim
+        return batch_value(c_lim, n)

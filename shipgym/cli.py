@@ -18,7 +18,8 @@ Subcommands::
     shipgym train --ray [ADDRESS] [--ray-cpus N] --sweep FILE [--seeds S1,S2,...] [--out DIR]
     shipgym benchmark [--episodes N] [--json OUT] [--csv OUT] [--plots DIR] [--out DIR]
                       [--env ID]... [--controller NAME]... [--condition C]... [--jobs N]
-                      [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N] [--no-throughput]
+                      [--ray [ADDRESS]] [--ray-cpus N] [--task-episodes N]
+                      [--throughput [--throughput-steps N]]
     shipgym identify PATH [--format F] [--columns MAP] [--max-gap S] [--length L]
                      [--model nomoto1|nomoto2|norrbin|bech|rvg3dof|vmm:...|kvlcc2]
                      [--json OUT|-] [--plot OUT.png] [--window S|auto|none] [--holdout FRAC]
@@ -1158,7 +1159,68 @@ def _build_train(sub: Any) -> None:
 # ------------------------------------------------------------------------------------------
 # benchmark
 # ------------------------------------------------------------------------------------------
+def _benchmark_plan(args: argparse.Namespace, say: Callable[[str], None]) -> None:
+    """The benchmark's first line, before anything heavy is imported or compiled: what it runs."""
+    from shipgym.benchmark.runner import CONDITIONS, CONTROLLERS, benchmark_cells
+    from shipgym.envs import CURRENT_ENV_IDS
+
+    envs = args.env or CURRENT_ENV_IDS
+    controllers = args.controller or CONTROLLERS
+    conditions = args.condition or CONDITIONS
+    cells = len(benchmark_cells(envs, controllers, conditions))
+
+    def n(count: int, word: str) -> str:
+        return f"{count:,} {word}{'s' * (count != 1)}"
+
+    say(
+        f"shipgym benchmark: {n(cells, 'evaluation')} of {n(args.episodes, 'episode')} "
+        f"({n(cells * args.episodes, 'episode')}: {n(len(envs), 'env')}, "
+        f"{n(len(controllers), 'controller')}, {n(len(conditions), 'condition')})"
+        + (" on Ray" if args.ray is not None else "")
+        + (", then PPO's training throughput" if args.throughput else "")
+    )
+    if args.no_throughput:
+        say("--no-throughput is the default now (--throughput measures PPO's throughput)")
+
+
+def _benchmark_kernels(args: argparse.Namespace, say: Callable[[str], None]) -> None:
+    """From a cold kernel cache, say so and compile the kernels the benchmark needs, at once in
+    one process per part, so that its evaluation processes load them rather than each compiling
+    them."""
+    import time
+
+    from shipgym.models._jit import CACHE_DIR
+    from shipgym.warmup import BENCHMARK_GROUPS, cold_parts, compile_estimate_s, warm_cache
+
+    if not CACHE_DIR:
+        say("kernel cache off (SHIPGYM_NO_CACHE): every process compiles the kernels it uses")
+        return
+    if args.ray not in (None, "local") or not any(cold_parts(g) for g in BENCHMARK_GROUPS):
+        return  # warm, or the episodes run on a cluster's own machines
+    estimate = compile_estimate_s(BENCHMARK_GROUPS)
+    say(f"compiling the kernels (first run only, about {max(10, round(estimate, -1)):.0f} s)")
+    t0 = time.perf_counter()
+    if warm_cache(BENCHMARK_GROUPS, say=say):
+        say(f"kernels compiled in {time.perf_counter() - t0:.0f} s")
+    else:
+        say("compiling the kernels ahead failed; each evaluation compiles what it uses")
+
+
 def _run_benchmark(args: argparse.Namespace) -> int:
+    ray = _ray_options(args)
+    if ray is not None and args.jobs is not None:
+        raise ValueError(
+            "--jobs sets the local process pool; with --ray the Ray cluster's CPUs run the "
+            "episodes (--ray-cpus for a Ray started on this machine)"
+        )
+    out = _output_dir(args.out, "--out")
+    json_path = _output_path(args.json, "--json", ".json") or out / "benchmark.json"
+    csv_path = _output_path(args.csv, "--csv", ".csv") or out / "benchmark.csv"
+    plots = _output_dir(args.plots, "--plots") if args.plots else out
+    progress = (lambda line: None) if args.quiet else _progress
+    _benchmark_plan(args, progress)
+    _benchmark_kernels(args, progress)
+
     import json
 
     from shipgym.benchmark.evaluate import EpisodeError
@@ -1172,19 +1234,8 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     from shipgym.benchmark.throughput import ppo_throughput, throughput_table
     from shipgym.cluster import ClusterTaskError
 
-    ray = _ray_options(args)
-    if ray is not None and args.jobs is not None:
-        raise ValueError(
-            "--jobs sets the local process pool; with --ray the Ray cluster's CPUs run the "
-            "episodes (--ray-cpus for a Ray started on this machine)"
-        )
-    out = _output_dir(args.out, "--out")
-    json_path = _output_path(args.json, "--json", ".json") or out / "benchmark.json"
-    csv_path = _output_path(args.csv, "--csv", ".csv") or out / "benchmark.csv"
-    plots = _output_dir(args.plots, "--plots") if args.plots else out
     envs = args.env or None
     controllers = args.controller or None
-    progress = (lambda line: None) if args.quiet else _progress
     kwargs: dict[str, Any] = {}
     if envs:
         kwargs["envs"] = envs
@@ -1224,7 +1275,7 @@ def _run_benchmark(args: argparse.Namespace) -> int:
     write_atomically(outputs)
     for target, _ in outputs:
         print(f"wrote {target}")
-    if not args.no_throughput:
+    if args.throughput:
         rows = ppo_throughput(result.envs, timesteps=args.throughput_steps, progress=progress)
         print(throughput_table(rows))
         outputs = [
@@ -1254,7 +1305,8 @@ def _build_benchmark(sub: Any) -> None:
             "noise and an actuator delay. Prints a table of mean +- std of each metric, "
             "writes JSON (a list of 'shipgym evaluate' objects with per-episode values and "
             "bootstrap 95 %% intervals) and CSV, figures of metrics, robustness and "
-            "trajectories, and PPO's training throughput on each env against CartPole-v1."
+            "trajectories; with --throughput also PPO's training throughput on each env "
+            "against CartPole-v1."
         ),
     )
     p.add_argument(
@@ -1303,15 +1355,27 @@ def _build_benchmark(sub: Any) -> None:
         default=None,
         help="only this condition (repeatable; default: all)",
     )
-    p.add_argument(
-        "--no-throughput", action="store_true", help="skip the PPO throughput measurement"
+    throughput = p.add_mutually_exclusive_group()
+    throughput.add_argument(
+        "--throughput",
+        action="store_true",
+        help=(
+            "after the evaluations, measure PPO's training throughput on each env against "
+            "CartPole-v1 in interleaved rounds, with the machine's load (minutes; needs an idle "
+            "machine to be comparable)"
+        ),
+    )
+    throughput.add_argument(
+        "--no-throughput",
+        action="store_true",
+        help="the default now (accepted for older scripts)",
     )
     p.add_argument(
         "--throughput-steps",
         type=_int_in(1, 10**8),
         default=16_384,
         metavar="N",
-        help="timed PPO steps per env and run (%(default)s)",
+        help="with --throughput: timed PPO steps per env and run (%(default)s)",
     )
     p.add_argument(
         "--jobs",

@@ -13,12 +13,18 @@ entry points once with the argument types they always get, so the cache holds ev
   the R/V Gunnerus model's windows, on short synthetic records.
 
 The parts are independent: ``python -m shipgym.warmup --parallel`` runs them in two processes
-at once and marks the cache warm, so the next call costs nothing (the test suite does this
-before its workers start).
+at once, so the next call costs nothing (the test suite does this before its workers start).
+A part that has run leaves a marker in the cache folder, which is keyed by the kernels' content
+(:data:`shipgym.models._jit.CACHE_DIR`): :func:`cold_parts` tells which parts a run would have
+to compile, and :func:`compile_estimate_s` about how long that takes
+(:data:`COLD_COMPILE_S`, measured), which ``shipgym benchmark`` announces before it warms
+the parts it needs (:data:`BENCHMARK_GROUPS`).
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 import time
 import warnings
@@ -27,7 +33,17 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["PARALLEL_GROUPS", "PARTS", "main", "warm", "warm_cache"]
+__all__ = [
+    "BENCHMARK_GROUPS",
+    "COLD_COMPILE_S",
+    "PARALLEL_GROUPS",
+    "PARTS",
+    "cold_parts",
+    "compile_estimate_s",
+    "main",
+    "warm",
+    "warm_cache",
+]
 
 
 def _envs() -> None:
@@ -80,48 +96,117 @@ PARTS: dict[str, Callable[[], None]] = {"envs": _envs, "models": _models, "sysid
 """The parts of the warm-up by name."""
 
 
-def warm(parts: Sequence[str] = tuple(PARTS), say: Callable[[str], None] = print) -> None:
-    """Run the warm-up ``parts`` (names of :data:`PARTS`) in this process."""
+def _marker(part: str) -> Path | None:
+    """The file that says part ``part`` of the warm-up has filled the cache (None: no cache)."""
+    from shipgym.models._jit import CACHE_DIR
+
+    return Path(CACHE_DIR) / f"warmup-{part}.done" if CACHE_DIR else None
+
+
+def _check(parts: Sequence[str]) -> None:
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
         raise ValueError(f"unknown warm-up part(s) {unknown}; expected any of {list(PARTS)}")
+
+
+def warm(parts: Sequence[str] = tuple(PARTS), say: Callable[[str], None] = print) -> None:
+    """Run the warm-up ``parts`` (names of :data:`PARTS`) in this process and mark each warm."""
+    _check(parts)
     for part in parts:
         t0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             PARTS[part]()
+        marker = _marker(part)
+        if marker is not None:
+            marker.parent.mkdir(parents=True, exist_ok=True)
+            marker.touch()
         say(f"shipgym warm-up: {part} in {time.perf_counter() - t0:.1f} s")
 
 
-#: The parts split in two processes of about equal compile time (about 60 s each cold on a
-#: 2.45 GHz Zen 3 core).
+def cold_parts(parts: Sequence[str] = tuple(PARTS)) -> list[str]:
+    """The ``parts`` whose kernels are not in the cache yet (all of them without a cache)."""
+    _check(parts)
+    return [p for p in parts if (marker := _marker(p)) is None or not marker.exists()]
+
+
+#: Seconds of one core to compile each part from a cold cache, each part in its own process:
+#: ``SHIPGYM_CACHE_DIR=<empty folder> python -m shipgym.warmup <part>`` on one core of a
+#: two-vCPU AMD EPYC virtual machine, measured 2026-11-27 (Numba 0.68.1; the process had its core
+#: all but 5 % of the time: user CPU time 63, 25 and 60 s).
+COLD_COMPILE_S: dict[str, float] = {"envs": 67.0, "models": 25.0, "sysid": 68.0}
+
+#: The parts split in processes of about equal compile time.
 PARALLEL_GROUPS: tuple[tuple[str, ...], ...] = (("envs", "models"), ("sysid",))
 
-_MARKER = "warmup.done"
+#: The parts ``shipgym benchmark`` needs (envs and the models' linearisations), one process each.
+BENCHMARK_GROUPS: tuple[tuple[str, ...], ...] = (("envs",), ("models",))
 
 
-def warm_cache(groups: Sequence[Sequence[str]] = PARALLEL_GROUPS) -> bool:
+def compile_estimate_s(
+    groups: Sequence[Sequence[str]] = PARALLEL_GROUPS,
+    cpus: int | None = None,
+    other_load: float | None = None,
+) -> float:
+    """About how long :func:`warm_cache` of ``groups`` takes, from :data:`COLD_COMPILE_S`.
+
+    On ``cpus`` idle cores (default: this machine's) it is the longest group, or the total
+    shared out over the cores when there are more groups than cores; parts already warm
+    (:func:`cold_parts`) cost nothing. ``other_load`` processes of others that want a core
+    meanwhile (default: the 1-minute load average less this process, where the system has one)
+    share the cores with the compiling processes and slow them down in proportion.
+    """
+    if cpus is None:
+        cpus = os.cpu_count() or 1
+    if cpus < 1:
+        raise ValueError(f"cpus must be >= 1, got {cpus!r}")
+    if other_load is None:
+        try:
+            other_load = max(0.0, os.getloadavg()[0] - 1.0)
+        except OSError:  # no load average (Windows)
+            other_load = 0.0
+    if other_load < 0:
+        raise ValueError(f"other_load must be >= 0, got {other_load!r}")
+    times = [sum(COLD_COMPILE_S[p] for p in cold_parts(group)) for group in groups]
+    running = min(cpus, sum(t > 0 for t in times))
+    idle = max([*times, sum(times) / cpus])
+    return idle * max(1.0, (other_load + running) / cpus)
+
+
+def warm_cache(
+    groups: Sequence[Sequence[str]] = PARALLEL_GROUPS, say: Callable[[str], None] = print
+) -> bool:
     """Fill the kernel cache once, each group in its own process, all at once.
 
-    Returns True when the cache is warm afterwards. Nothing runs when the cache is already
-    warm (a marker in the cache folder, which is keyed by the kernels' sources) or disabled
-    (``SHIPGYM_NO_CACHE``).
+    Only the cold parts (:func:`cold_parts`) run; the processes import the same copy of
+    shipgym as this one. Their lines (one per part) are passed to ``say`` when they end.
+    Returns True when the parts are warm afterwards, False when one failed or the cache is
+    disabled (``SHIPGYM_NO_CACHE``).
     """
-    import subprocess
+    import shipgym
+    from shipgym.models._jit import CACHE_DIR
 
-    from shipgym.models import _jit
-
-    if not _jit._CACHE_DIR:
+    if not CACHE_DIR:
         return False
-    marker = Path(_jit._CACHE_DIR) / _MARKER
-    if marker.exists():
-        return True
-    procs = [subprocess.Popen([sys.executable, "-m", "shipgym.warmup", *group]) for group in groups]
-    if any(proc.wait() != 0 for proc in procs):
-        return False
-    marker.parent.mkdir(parents=True, exist_ok=True)
-    marker.touch()
-    return True
+    todo = [cold for group in groups if (cold := cold_parts(group))]
+    site = str(Path(shipgym.__file__).resolve().parents[1])
+    path = os.pathsep.join(p for p in (site, os.environ.get("PYTHONPATH")) if p)
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "shipgym.warmup", *group],
+            env={**os.environ, "PYTHONPATH": path},
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for group in todo
+    ]
+    ok = True
+    for proc in procs:
+        out, _ = proc.communicate()
+        for line in out.splitlines():
+            say(line)
+        ok = ok and proc.returncode == 0
+    return ok
 
 
 def main(argv: Sequence[str] | None = None) -> int:

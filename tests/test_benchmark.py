@@ -169,7 +169,8 @@ def test_ppo_throughput_measures_both_in_one_run() -> None:
     assert rows[0]["ratio"] == 1.0 and rows[0]["met"] is None
     assert all(r["steps_per_s"] > 0 and len(r["runs"]) == 1 for r in rows)
     assert math.isclose(rows[1]["ratio"], rows[1]["steps_per_s"] / rows[0]["steps_per_s"])
-    assert rows[1]["met"] is (rows[1]["ratio"] >= 0.9)
+    # on a machine other processes share, the ratio means nothing and no verdict is given
+    assert rows[1]["met"] is (None if rows[1]["machine_busy"] else rows[1]["ratio"] >= 0.9)
 
 
 # ------------------------------------------------------------------------------------------
@@ -183,7 +184,6 @@ def test_benchmark_command_writes_table_json_csv_and_figures(tmp_path: Path, cap
             "2",
             "--env",
             "shipgym/RVGSpeed-v1",
-            "--no-throughput",
             "--out",
             str(tmp_path),
             "--quiet",

@@ -12,8 +12,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import gymnasium as gym
+import numpy as np
 import pytest
+from gymnasium.vector import VectorWrapper
 
 from shipgym.benchmark.evaluate import EpisodeError, evaluate, merge_results
 from shipgym.benchmark.policies import make_policy
@@ -32,20 +33,20 @@ def _quiet(line: str) -> None:
     pass
 
 
-def _failing_at(seed: int, step: int) -> type[gym.Wrapper]:
-    """A wrapper raising at ``step`` of the episode reset with ``seed`` (defined in a
-    function, so that Ray sends the class itself to the workers)."""
+def _failing_at(seed: int, step: int) -> type[VectorWrapper]:
+    """A vector wrapper raising at ``step`` of a batch that holds the episode reset with
+    ``seed`` (defined in a function, so that Ray sends the class itself to the workers)."""
 
-    class FailAt(gym.Wrapper):
+    class FailAt(VectorWrapper):
         def reset(self, *, seed=None, options=None):
-            self.failing, self.steps = seed == FAIL_SEED, 0
+            self.failing, self.steps = FAIL_SEED in np.atleast_1d(seed), 0
             return self.env.reset(seed=seed, options=options)
 
-        def step(self, action):
+        def step(self, actions):
             self.steps += 1
             if self.failing and self.steps == step:
                 raise ZeroDivisionError("injected fault")
-            return self.env.step(action)
+            return self.env.step(actions)
 
     FAIL_SEED = seed
     return FailAt
@@ -163,7 +164,7 @@ def test_benchmark_with_ray_equals_the_local_run(local_ray, tmp_path: Path, caps
     local = run_benchmark(jobs=1, **kw)
     argv = ["benchmark", "--episodes", "2", "--env", ENV, "--controller", "classic"]
     argv += ["--controller", "zero", "--condition", "nominal", "--condition", "noise"]
-    argv += ["--out", str(tmp_path), "--no-throughput", "--ray", "--task-episodes", "1"]
+    argv += ["--out", str(tmp_path), "--ray", "--task-episodes", "1"]
     assert main(argv) == 0
     err = capsys.readouterr().err
     assert "6 Ray tasks of up to 1 episodes for 3 evaluation(s)" in err

@@ -234,22 +234,24 @@ def test_engineering_metrics_against_hand_computed_signals() -> None:
 
 
 class _BlowUpOnOddSeeds:
-    """Wrapper factory: the ship's state turns non-finite before step 3 of odd-seeded episodes
-    (what a diverging integration leaves), so the env ends them as numerical blow-ups."""
+    """Vector wrapper factory: the ships' states turn non-finite before step 3 of odd-seeded
+    episodes (what a diverging integration leaves), so the env ends them as numerical
+    blow-ups while the even-seeded episodes beside them go on."""
 
     def __call__(self, env):
-        import gymnasium as gym
+        from gymnasium.vector import VectorWrapper
 
-        class BlowUp(gym.Wrapper):
-            def reset(self, **kwargs):
-                self.blow, self.steps = kwargs.get("seed", 0) % 2 == 1, 0
-                return super().reset(**kwargs)
+        class BlowUp(VectorWrapper):
+            def reset(self, *, seed=None, options=None):
+                self.blow = np.asarray(seed) % 2 == 1
+                self.steps = 0
+                return super().reset(seed=seed, options=options)
 
-            def step(self, action):
+            def step(self, actions):
                 self.steps += 1
-                if self.blow and self.steps == 3:
-                    self.env.unwrapped.task.x[0, :] = np.nan
-                return super().step(action)
+                if self.steps == 3:
+                    self.env.unwrapped.task.x[self.blow, :] = np.nan
+                return super().step(actions)
 
         return BlowUp(env)
 

@@ -1,8 +1,10 @@
-"""The on-disk cache of compiled kernels repairs an entry it cannot read."""
+"""The on-disk cache of compiled kernels: keyed by content (two copies of the same code share
+it, a change misses), filled by the warm-up, and an entry it cannot read repairs itself."""
 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,11 +19,16 @@ _RUN = (
 )
 
 
-def _run(cache: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "SHIPGYM_CACHE_DIR": str(cache)}
+def _env(cache: Path, **extra: str) -> dict[str, str]:
+    """This process's environment with the kernel cache in ``cache`` and ``extra`` set."""
+    env = {**os.environ, "SHIPGYM_CACHE_DIR": str(cache), **extra}
     env.pop("SHIPGYM_NO_CACHE", None)
+    return env
+
+
+def _run(cache: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-c", _RUN], env=env, capture_output=True, text=True, timeout=300
+        [sys.executable, "-c", _RUN], env=_env(cache), capture_output=True, text=True, timeout=300
     )
 
 
@@ -64,24 +71,91 @@ _SIMULATE = (
 )
 
 
-def test_the_warm_up_fills_the_cache_that_later_processes_load(tmp_path: Path) -> None:
+def test_the_warm_up_fills_the_cache_that_later_processes_and_copies_load(tmp_path: Path) -> None:
     cache = tmp_path / "cache"
-    env = {**os.environ, "SHIPGYM_CACHE_DIR": str(cache)}
-    env.pop("SHIPGYM_NO_CACHE", None)
 
-    def run(*args: str) -> subprocess.CompletedProcess[str]:
+    def run(*args: str, **extra: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run(
-            [sys.executable, *args], env=env, capture_output=True, text=True, timeout=600
+            [sys.executable, *args],
+            env=_env(cache, **extra),
+            capture_output=True,
+            text=True,
+            timeout=600,
+            cwd=tmp_path,
         )
 
     bad = run("-m", "shipgym.warmup", "kernels")
     assert bad.returncode == 2 and "unknown warm-up part(s) ['kernels']" in bad.stderr
+    cold = run("-c", "from shipgym.warmup import cold_parts; print(*cold_parts())")
+    assert cold.stdout.split() == ["envs", "models", "sysid"], cold.stderr
     warm = run("-m", "shipgym.warmup", "models")
     assert warm.returncode == 0 and "shipgym warm-up: models in" in warm.stdout, warm.stderr
+    cold = run("-c", "from shipgym.warmup import cold_parts; print(*cold_parts())")
+    assert cold.stdout.split() == ["envs", "sysid"], cold.stderr
     # a later process compiles nothing for a model simulation: it loads the kernel
     later = run("-c", _SIMULATE)
     assert later.returncode == 0, later.stderr
     assert later.stdout.split() == ["1", "0"]
+    # nor does a copy of the package at another path (an installed copy beside a checkout)
+    import shipgym
+
+    site = Path(shipgym.__file__).resolve().parents[1]
+    copy = tmp_path / "site"
+    for package in ("shipgym", "controllers"):
+        shutil.copytree(
+            site / package, copy / package, ignore=shutil.ignore_patterns("__pycache__", "*.zip")
+        )
+    where = run("-c", "import shipgym; print(shipgym.__file__)", PYTHONPATH=str(copy))
+    assert where.stdout.strip() == str(copy / "shipgym" / "__init__.py"), where.stderr
+    copied = run("-c", _SIMULATE, PYTHONPATH=str(copy))
+    assert copied.returncode == 0, copied.stderr
+    assert copied.stdout.split() == ["1", "0"]
+    assert len(list(cache.glob("numba-*"))) == 1  # one folder: the same key for both copies
+
+
+# a module of kernels outside the package, in a folder given by PYTHONPATH
+_MODULE = """
+from shipgym.models._jit import kernel
+
+
+@kernel
+def scaled(x):
+    return {factor} * x
+"""
+_CALL = (
+    "import kernel_copy as m\n"
+    "print(m.__file__, m.scaled(2.0), len(m.scaled.stats.cache_hits),"
+    " len(m.scaled.stats.cache_misses))\n"
+)
+
+
+def test_two_copies_of_the_same_kernels_share_one_entry_and_a_change_misses(
+    tmp_path: Path,
+) -> None:
+    cache = tmp_path / "cache"
+
+    def call(folder: Path, factor: float) -> list[str]:
+        folder.mkdir(exist_ok=True)
+        (folder / "kernel_copy.py").write_text(_MODULE.format(factor=factor))
+        run = subprocess.run(
+            [sys.executable, "-c", _CALL],
+            env=_env(cache, PYTHONPATH=str(folder)),
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
+        )
+        assert run.returncode == 0, run.stderr
+        where, value, hits, misses = run.stdout.split()
+        assert where == str(folder / "kernel_copy.py")
+        assert float(value) == 2.0 * factor
+        return [hits, misses]
+
+    assert call(tmp_path / "checkout", 3.0) == ["0", "1"]  # compiled and saved
+    assert call(tmp_path / "installed", 3.0) == ["1", "0"]  # the same content elsewhere: loaded
+    assert call(tmp_path / "checkout", 3.0) == ["1", "0"]
+    assert call(tmp_path / "installed", 5.0) == ["0", "1"]  # changed: compiled afresh
+    assert len(list(cache.rglob("kernel_copy.scaled-*.nbi"))) == 1
 
 
 _TARGET = (

@@ -1,13 +1,18 @@
 """Run a policy on an environment over seeded episodes and compute the task metrics.
 
 Episode ``k`` is reset with seed ``seed + k``, so every policy sees the same initial states,
-setpoints, paths, targets and current draws. An episode's numbers depend on its seed only, not
-on how many episodes run beside it: a batched policy (a neural network) is always called on
-blocks of :data:`POLICY_BLOCK` rows in which the episode of seed ``s`` takes row
-``s % POLICY_BLOCK`` (matrix kernels round a row differently by its place in the batch), so a
+setpoints, paths, targets and current draws. The episodes of an evaluation run as one batched
+rollout: the package's vector env in Gymnasium's manual mode steps all of them at once (an
+episode that ends stays ended on its row), the classic controllers act on arrays of ships, and
+the signals the metrics need are recorded in preallocated arrays. An episode's numbers depend
+on its seed only, not on how many episodes run beside it: the vector env's rows are independent,
+each classic controller's row is its own ship, and a batched policy (a neural network) is always
+called on blocks of :data:`POLICY_BLOCK` rows in which the episode of seed ``s`` takes row
+``s % POLICY_BLOCK`` (matrix kernels round a row differently by its place in the batch). So a
 campaign split into batches of seeds (on a Ray cluster, :mod:`shipgym.benchmark.runner`) and
-merged with :func:`merge_results` gives the numbers of one run. An error raised in an episode
-becomes an :class:`EpisodeError` naming the env, controller, condition and seed. Metrics (means
+merged with :func:`merge_results` gives the numbers of one run, and they are those of the single
+env stepped episode after episode. An error raised in an episode becomes an
+:class:`EpisodeError` naming the env, controller, condition and seed. Metrics (means
 over episodes):
 
 * heading envs: ``heading_rms_deg`` (RMS heading error over the whole episode),
@@ -53,6 +58,8 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.envs.registration import load_env_creator
+from gymnasium.vector import AutoresetMode, VectorEnv
 
 import shipgym  # noqa: F401  (registers the environments)
 from shipgym.benchmark.stats import bootstrap_ci
@@ -125,20 +132,55 @@ class EpisodeError(RuntimeError):
 
 @dataclass
 class EpisodeLog:
-    """Signals of one episode, one row per step (after the step)."""
+    """Signals of one episode, one row per step (after the step).
+
+    Attributes
+    ----------
+    seed : int
+        The episode's reset seed.
+    time : ndarray, shape (L,)
+        Time after each step [s].
+    state : ndarray, shape (L, nx)
+        The true state after each step (``info["state"]``).
+    action : ndarray, shape (L, na)
+        The normalised action of each step, clipped to [-1, 1] (float32, as the env takes it).
+    reward : ndarray, shape (L,)
+        Reward of each step.
+    signals : dict of str to ndarray
+        Every scalar entry of the step ``info`` (the task metrics, the current) over the
+        episode, shape (L,).
+    termination_reason : str
+        How the episode ended (``info["termination_reason"]`` of its last step).
+    reset_info : dict
+        The ``info`` of the episode's reset (as the single env gives it).
+    extras : dict
+        ``waypoints`` (path following) and ``target`` (the target's position at every step,
+        target tracking).
+    """
 
     seed: int
-    time: list[float] = field(default_factory=list)
-    state: list[np.ndarray] = field(default_factory=list)
-    action: list[np.ndarray] = field(default_factory=list)
-    reward: list[float] = field(default_factory=list)
-    info: list[dict[str, Any]] = field(default_factory=list)
+    time: np.ndarray
+    state: np.ndarray
+    action: np.ndarray
+    reward: np.ndarray
+    signals: dict[str, np.ndarray]
+    termination_reason: str
     reset_info: dict[str, Any] = field(default_factory=dict)
     extras: dict[str, Any] = field(default_factory=dict)
 
     def signal(self, key: str) -> np.ndarray:
         """An ``info`` entry over the episode as an array."""
-        return np.array([i[key] for i in self.info], dtype=float)
+        try:
+            return self.signals[key]
+        except KeyError:
+            raise KeyError(
+                f"no signal {key!r} in this episode's log; it has {sorted(self.signals)}"
+            ) from None
+
+    @property
+    def steps(self) -> int:
+        """Steps of the episode."""
+        return int(self.reward.size)
 
     @property
     def episode_return(self) -> float:
@@ -339,7 +381,7 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
             "cross_track_straight_m": (
                 float(np.sqrt(np.mean(straight**2))) if straight.size else math.nan
             ),
-            "completed": float(bool(log.info[-1]["completed"])),
+            "completed": float(bool(log.signal("completed")[-1])),
             **_wear(rudder, dt),
         }
     elif env_task(env_id) == "RVGTargetTracking":
@@ -357,40 +399,42 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
     return {**out, **extra}
 
 
-def _wrapped(env: gym.Env, wrappers: Sequence[Callable[[gym.Env], gym.Env]]) -> gym.Env:
+#: Most episodes stepped as one vector env; more run as consecutive batches of this size (the
+#: recorded signals of a batch grow with its size: about 10 MB per 100 Gunnerus episodes).
+VECTOR_BATCH = 256
+
+
+def vector_env(
+    env_id: str,
+    num_envs: int,
+    env_kwargs: dict[str, Any] | None = None,
+    wrappers: Sequence[Callable[[VectorEnv], VectorEnv]] = (),
+) -> VectorEnv:
+    """The package's vector env of ``env_id`` with ``num_envs`` sub-envs in Gymnasium's manual
+    mode (``AutoresetMode.DISABLED``: an episode that ends stays on its row, nothing starts
+    a new one), with the registered keyword arguments of ``env_id`` updated by
+    ``env_kwargs`` and the vector ``wrappers`` applied in order."""
+    spec = gym.spec(env_id)
+    creator = spec.vector_entry_point
+    if isinstance(creator, str):
+        creator = load_env_creator(creator)
+    kwargs = {**spec.kwargs, **(env_kwargs or {})}
+    env: VectorEnv = creator(num_envs=num_envs, autoreset_mode=AutoresetMode.DISABLED, **kwargs)
     for wrap in wrappers:
         env = wrap(env)
     return env
 
 
-def _start(
-    env: gym.Env, seed: int, options: dict[str, Any] | None
-) -> tuple[EpisodeLog, np.ndarray, dict[str, Any]]:
-    """Reset ``env`` with ``seed``; the episode's log, first observation and reset info."""
-    log = EpisodeLog(seed=seed)
-    obs, info = env.reset(seed=seed, options=options)
-    log.reset_info = info
-    task = env.unwrapped.task
-    if hasattr(task, "waypoints"):
-        log.extras["waypoints"] = task.waypoints(0)
-    return log, obs, info
-
-
-def _record_step(
-    env: gym.Env, log: EpisodeLog, action: np.ndarray, targets: list[np.ndarray], dt: float
-) -> tuple[np.ndarray, bool]:
-    """Step ``env`` with ``action`` and log the step; the observation and whether it ended."""
-    action = np.asarray(action, dtype=np.float32)
-    obs, reward, terminated, truncated, info = env.step(action)
-    log.time.append(len(log.time) * dt + dt)
-    log.state.append(info["state"])
-    log.action.append(np.clip(action, -1.0, 1.0))
-    log.reward.append(float(reward))
-    log.info.append(info)
-    task = env.unwrapped.task
-    if hasattr(task, "target"):
-        targets.append(task.target[0].copy())
-    return obs, bool(terminated or truncated)
+def _row_info(info: dict[str, Any], k: int) -> dict[str, Any]:
+    """Row ``k`` of a vector ``info`` as the single env's ``info`` (Python scalars, arrays
+    copied)."""
+    out: dict[str, Any] = {}
+    for key, value in info.items():
+        if key.startswith("_"):
+            continue
+        v = value[k]
+        out[key] = v.copy() if isinstance(v, np.ndarray) else getattr(v, "item", lambda v=v: v)()
+    return out
 
 
 def _act_in_blocks(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> np.ndarray:
@@ -422,6 +466,118 @@ def _failing_seeds(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> tuple[
     return tuple(seeds)
 
 
+class _Actor:
+    """Calls a policy on a batch of episodes in the way it supports (see :func:`evaluate`)."""
+
+    def __init__(self, policy: Any, env: VectorEnv, seeds: Sequence[int]) -> None:
+        self.policy = policy
+        self.seeds = list(seeds)
+        self.vector = hasattr(policy, "reset_vector")
+        self.memoryless = not self.vector and hasattr(policy, "act_batch")
+        self.env = env.unwrapped
+        self.act_dim = int(env.single_action_space.shape[0])
+        if not (self.vector or self.memoryless) and len(self.seeds) != 1:
+            raise ValueError("a policy with act(obs, info) only runs one episode at a time")
+
+    def single_view(self) -> Any:
+        """A single env sharing the vector env's task (row 0): what ``reset(env, ...)`` of a
+        one-episode policy reads (``task``, ``dt``, the spaces)."""
+        view = self.env.single_env_cls()
+        view.task = self.env.task
+        return view
+
+    def reset(self, obs: np.ndarray, info: dict[str, Any]) -> None:
+        if self.vector:
+            self.policy.reset_vector(self.env, obs, info)
+        else:
+            self.policy.reset(self.single_view(), obs[0], _row_info(info, 0))
+
+    def act(self, obs: np.ndarray, info: dict[str, Any], alive: np.ndarray) -> np.ndarray:
+        """Actions of every row (rows not ``alive`` are ignored by the env)."""
+        if self.vector:
+            return np.asarray(self.policy.act_vector(obs, info), dtype=np.float32)
+        if self.memoryless:
+            live = np.flatnonzero(alive)
+            seeds = [self.seeds[j] for j in live]
+            try:
+                acted = _act_in_blocks(self.policy, obs[live], seeds)
+            except Exception as exc:
+                exc.seeds = _failing_seeds(self.policy, obs[live], seeds)  # type: ignore[attr-defined]
+                raise
+            actions = np.zeros((len(self.seeds), self.act_dim), dtype=np.float32)
+            actions[live] = acted
+            return actions
+        action = self.policy.act(obs[0], _row_info(info, 0))
+        return np.asarray(action, dtype=np.float32).reshape(1, self.act_dim)
+
+
+def _rollout(
+    env: VectorEnv, actor: _Actor, seeds: Sequence[int], options: dict[str, Any] | None
+) -> list[EpisodeLog]:
+    """Run the episodes ``seeds`` (one per row of ``env``) to their ends; their logs."""
+    base = env.unwrapped
+    task = base.task
+    n, steps = len(seeds), int(base.max_episode_steps)
+    obs, info = env.reset(seed=list(seeds), options=None if options is None else dict(options))
+    reset_infos = [_row_info(info, k) for k in range(n)]
+    x0 = np.array(info["state"])
+    actor.reset(obs, info)
+    skip = {"state", "measured_state", "termination_reason"}
+    keys = [k for k, v in info.items() if not k.startswith("_") and k not in skip]
+    # (n, steps, ...) so that an episode's samples are contiguous, as one episode's lists were
+    states = np.empty((n, steps, x0.shape[1]))
+    actions = np.empty((n, steps, actor.act_dim), dtype=np.float32)
+    rewards = np.empty((n, steps))
+    signals = {k: np.empty((n, steps), dtype=np.asarray(info[k]).dtype) for k in keys}
+    targets = np.empty((n, steps, 2)) if hasattr(task, "target") else None
+    alive = np.ones(n, dtype=np.bool_)
+    lengths = np.zeros(n, dtype=np.int64)
+    reasons = [""] * n
+    for t in range(steps):
+        a = actor.act(obs, info, alive)
+        obs, reward, terminated, truncated, info = env.step(a)
+        states[:, t] = info["state"]
+        actions[:, t] = np.clip(a, -1.0, 1.0)
+        rewards[:, t] = reward
+        for key in keys:
+            signals[key][:, t] = info[key]
+        if targets is not None:
+            targets[:, t] = task.target
+        ended = np.flatnonzero((terminated | truncated) & alive)
+        for k in ended:
+            lengths[k] = t + 1
+            reasons[k] = str(info["termination_reason"][k])
+        alive[ended] = False
+        if not alive.any():
+            break
+        if ended.size:  # the rows that ended feed the policy a finite state from now on
+            for key in ("state", "measured_state"):
+                if key in info:
+                    info[key][~alive] = x0[~alive]
+    logs = []
+    for k in range(n):
+        length = int(lengths[k])
+        extras: dict[str, Any] = {}
+        if hasattr(task, "waypoints"):
+            extras["waypoints"] = task.waypoints(k)
+        if targets is not None:
+            extras["target"] = targets[k, :length]
+        logs.append(
+            EpisodeLog(
+                seed=int(seeds[k]),
+                time=np.arange(length) * base.task.dt + base.task.dt,
+                state=states[k, :length],
+                action=actions[k, :length],
+                reward=rewards[k, :length],
+                signals={key: signals[key][k, :length] for key in keys},
+                termination_reason=reasons[k],
+                reset_info=reset_infos[k],
+                extras=extras,
+            )
+        )
+    return logs
+
+
 def evaluate(
     env_id: str,
     policy: Any,
@@ -432,37 +588,51 @@ def evaluate(
     reset_options: dict[str, Any] | None = None,
     progress: Callable[[str], None] | None = None,
     condition: str = "nominal",
-    wrappers: Sequence[Callable[[gym.Env], gym.Env]] = (),
+    wrappers: Sequence[Callable[[VectorEnv], VectorEnv]] = (),
 ) -> EvaluationResult:
     """Run ``policy`` for ``episodes`` episodes with seeds ``seed``, ``seed + 1``, ...
+
+    The episodes run as one batched rollout: the package's vector env of ``env_id`` in
+    Gymnasium's manual mode (:func:`vector_env`) steps all of them at once (at most
+    :data:`VECTOR_BATCH` per batch), episode ``k`` on a row reset with seed ``seed + k`` (the
+    single env reset with that seed: the same initial state, setpoints, path, target and
+    current). An episode that ends stays ended on its row while the others go on. The signals
+    the metrics need are recorded in preallocated arrays, and the metrics are computed from
+    them.
 
     Parameters
     ----------
     env_id : str
         One of :data:`shipgym.envs.ENV_IDS`.
     policy : object
-        Has ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (normalised). A
-        memoryless policy that also has ``act_batch(obs) -> actions`` (a batch of
-        observations, one row per episode) runs all episodes in lockstep, one call per step
-        and block of :data:`POLICY_BLOCK` episodes; an episode's actions do not depend on the
-        other episodes of the run.
+        One of three kinds, tried in this order:
+
+        * a policy for a batch of ships: ``reset_vector(env, obs, info)`` (``env`` the
+          unwrapped vector env, ``obs`` and ``info`` of every row) and ``act_vector(obs,
+          info) -> actions`` (one row per episode), as the classic controllers of
+          :mod:`shipgym.benchmark.policies`; a row's actions must depend on that row only;
+        * a memoryless policy with ``act_batch(obs) -> actions`` (a neural network): called on
+          blocks of :data:`POLICY_BLOCK` rows (see the module docstring);
+        * any policy with ``reset(env, obs, info)`` and ``act(obs, info) -> action`` (the
+          single env's ``obs`` and ``info``): its episodes run one after another, each as a
+          vector env of one.
     controller : str
         Name recorded in the result.
     episodes, seed : int
         Number of episodes and the first seed.
     env_kwargs : dict, optional
-        Keyword arguments for ``gymnasium.make`` (e.g. ``max_current_speed``).
+        Keyword arguments of the env (e.g. ``max_current_speed``, the ship).
     reset_options : dict, optional
         Options passed to every ``reset``.
     progress : callable, optional
-        Called with a short line after each episode (default: print to stderr).
+        Called with a short line per episode (default: print to stderr).
     condition : str
         Name of the scenario set, recorded in the result (the benchmark's ``nominal``,
         ``stress``, ...).
     wrappers : sequence of callables
-        Applied to each env in order (``env = w(env)``), e.g. the robustness conditions'
-        :class:`~shipgym.envs.wrappers.SensorNoise` and
-        :class:`~shipgym.envs.wrappers.ActuatorDelay`. Metrics are of the true motion.
+        Vector wrappers applied to the vector env in order (``env = w(env)``), e.g. the
+        robustness conditions' :class:`~shipgym.envs.wrappers.VectorSensorNoise` and
+        :class:`~shipgym.envs.wrappers.VectorActuatorDelay`. Metrics are of the true motion.
 
     Returns
     -------
@@ -472,11 +642,12 @@ def evaluate(
     ------
     EpisodeError
         If an episode raises (in the env, a wrapper, the policy or the metrics): names the
-        env, controller, condition and the episode's seed.
+        env, controller, condition and the episode's seed (the seeds of the batch when the
+        error cannot be pinned on one).
     """
     if env_id not in ENV_IDS:
         raise ValueError(f"unknown env {env_id!r}; expected one of {ENV_IDS}")
-    if not isinstance(episodes, int) or episodes < 1:
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
     if progress is None:
 
@@ -487,7 +658,7 @@ def evaluate(
         which = (
             f"episode with seed {seeds[0]}"
             if len(seeds) == 1
-            else f"one of the episodes with seeds {', '.join(map(str, seeds))}"
+            else f"one of the episodes with seeds {_seed_list(seeds)}"
         )
         return EpisodeError(
             f"{env_id} {controller} ({condition}): {which} failed: {type(exc).__name__}: {exc}",
@@ -497,20 +668,35 @@ def evaluate(
             seeds=tuple(seeds),
         )
 
-    batched = hasattr(policy, "act_batch")
-    n_envs = episodes if batched else 1
-    envs = [_wrapped(gym.make(env_id, **(env_kwargs or {})), wrappers) for _ in range(n_envs)]
-    dt = envs[0].unwrapped.dt
+    batched = hasattr(policy, "reset_vector") or hasattr(policy, "act_batch")
+    size = min(episodes, VECTOR_BATCH) if batched else 1
+    all_seeds = [seed + k for k in range(episodes)]
     logs: list[EpisodeLog] = []
+    env: VectorEnv | None = None
+    dt = math.nan
+    try:
+        for start in range(0, episodes, size):
+            seeds = all_seeds[start : start + size]
+            try:
+                if env is None or env.num_envs != len(seeds):
+                    if env is not None:
+                        env.close()
+                    env = vector_env(env_id, len(seeds), env_kwargs, wrappers)
+                    dt = float(env.unwrapped.task.dt)
+                logs += _rollout(env, _Actor(policy, env, seeds), seeds, reset_options)
+            except Exception as exc:
+                seed_k, exc_k = _failing_episode(env_id, env_kwargs, wrappers, policy, seeds,
+                                                 reset_options, exc)  # fmt: skip
+                raise failed(seed_k, exc_k) from exc_k
+    finally:
+        if env is not None:
+            env.close()
     per_episode: list[dict[str, float]] = []
-
-    def finish(log: EpisodeLog, targets: list[np.ndarray]) -> None:
-        if targets:
-            log.extras["target"] = np.asarray(targets)
-        head = f"{env_id} {controller} episode {len(logs) + 1}/{episodes} (seed {log.seed}): "
-        if log.info[-1]["termination_reason"] == BLOW_UP:
+    for k, log in enumerate(logs):
+        head = f"{env_id} {controller} episode {k + 1}/{episodes} (seed {log.seed}): "
+        if log.termination_reason == BLOW_UP:
             metrics = dict.fromkeys(METRICS[env_id], math.nan)
-            line = head + f"numerical blow-up at step {len(log.time)}: no return, no metrics"
+            line = head + f"numerical blow-up at step {log.steps}: no return, no metrics"
         else:
             try:
                 metrics = episode_metrics(env_id, log, dt)
@@ -521,78 +707,57 @@ def evaluate(
                 + f"return {log.episode_return:.1f}, "
                 + ", ".join(f"{key} {value:.3g}" for key, value in metrics.items())
             )
-        logs.append(log)
         per_episode.append(metrics)
         progress(line)
-
-    try:
-        if batched:
-            # memoryless policy: every episode at once, one policy call per step and block
-            starts = []
-            for k, env in enumerate(envs):
-                try:
-                    starts.append(_start(env, seed + k, reset_options))
-                    policy.reset(env.unwrapped, starts[-1][1], starts[-1][2])
-                except Exception as exc:
-                    raise failed([seed + k], exc) from exc
-            ep_logs = [log for log, _, _ in starts]
-            obs = np.stack([o for _, o, _ in starts])
-            targets: list[list[np.ndarray]] = [[] for _ in envs]
-            active = list(range(episodes))
-            while active:
-                seeds = [seed + k for k in active]
-                try:
-                    actions = _act_in_blocks(policy, obs[active], seeds)
-                except Exception as exc:
-                    raise failed(_failing_seeds(policy, obs[active], seeds), exc) from exc
-                still = []
-                for j, k in enumerate(active):
-                    try:
-                        o, done = _record_step(envs[k], ep_logs[k], actions[j], targets[k], dt)
-                    except Exception as exc:
-                        raise failed([seed + k], exc) from exc
-                    obs[k] = o
-                    if done:
-                        finish(ep_logs[k], targets[k])
-                    else:
-                        still.append(k)
-                active = still
-            order = np.argsort([log.seed for log in logs])
-            logs[:] = [logs[i] for i in order]
-            per_episode[:] = [per_episode[i] for i in order]
-        else:
-            env = envs[0]
-            for k in range(episodes):
-                try:
-                    log, obs_k, info = _start(env, seed + k, reset_options)
-                    policy.reset(env.unwrapped, obs_k, info)
-                    targets_k: list[np.ndarray] = []
-                    done = False
-                    while not done:
-                        action = np.asarray(policy.act(obs_k, log.info[-1] if log.info else info))
-                        obs_k, done = _record_step(env, log, action, targets_k, dt)
-                except Exception as exc:
-                    raise failed([seed + k], exc) from exc
-                finish(log, targets_k)
-    finally:
-        for env in envs:
-            env.close()
     return EvaluationResult(
         env=env_id,
         controller=controller,
         episodes=episodes,
         seed=seed,
         returns=[
-            math.nan if log.info[-1]["termination_reason"] == BLOW_UP else log.episode_return
-            for log in logs
+            math.nan if log.termination_reason == BLOW_UP else log.episode_return for log in logs
         ],
         per_episode=per_episode,
         logs=logs,
         options=dict(reset_options or {}),
         condition=condition,
-        terminations=[str(log.info[-1]["termination_reason"]) for log in logs],
-        lengths=[len(log.time) for log in logs],
+        terminations=[log.termination_reason for log in logs],
+        lengths=[log.steps for log in logs],
     )
+
+
+def _failing_episode(
+    env_id: str,
+    env_kwargs: dict[str, Any] | None,
+    wrappers: Sequence[Callable[[VectorEnv], VectorEnv]],
+    policy: Any,
+    seeds: Sequence[int],
+    options: dict[str, Any] | None,
+    exc: Exception,
+) -> tuple[Sequence[int], Exception]:
+    """The seed whose episode alone raises, and its error, after a batch of ``seeds`` raised
+    ``exc``: each episode is run again alone until one raises (``exc`` and every seed if
+    none does; the seeds ``act_batch`` named if a batched policy raised)."""
+    if hasattr(exc, "seeds"):
+        return exc.seeds, exc
+    if len(seeds) > 1:
+        for s in seeds:
+            single = vector_env(env_id, 1, env_kwargs, wrappers)
+            try:
+                _rollout(single, _Actor(policy, single, [s]), [s], options)
+            except Exception as alone:
+                return [s], alone
+            finally:
+                single.close()
+    return seeds, exc
+
+
+def _seed_list(seeds: Sequence[int]) -> str:
+    """``"3, 4, 5"``, or ``"3..99"`` for a run of consecutive seeds."""
+    seeds = list(seeds)
+    if len(seeds) > 3 and seeds == list(range(seeds[0], seeds[0] + len(seeds))):
+        return f"{seeds[0]}..{seeds[-1]}"
+    return ", ".join(map(str, seeds))
 
 
 def merge_results(parts: Sequence[EvaluationResult]) -> EvaluationResult:

@@ -78,7 +78,7 @@ def plot_episode(result: EvaluationResult, log: EpisodeLog, path: str | Path) ->
     ax.set_xlabel("time [s]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    reason = log.info[-1]["termination_reason"]
+    reason = log.termination_reason
     outcome = (
         f"NUMERICAL BLOW-UP at step {len(log.time)} (no return, no metrics)"
         if reason == BLOW_UP

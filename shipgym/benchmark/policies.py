@@ -57,10 +57,11 @@ import numpy as np
 from controllers import (
     ConstantBearingGuidance,
     HeadingAutopilot,
-    PodCommand,
     SpeedAutopilot,
+    course_and_speed,
     design_model,
     linearised_drag_model,
+    pod_env_actions,
 )
 from controllers.los import LOSGuidance
 from controllers.paths import WaypointPath
@@ -197,22 +198,27 @@ def _rvg_speed_autopilot(
 
 
 def _measured(info: dict[str, Any]) -> np.ndarray:
-    """The state as the ship's sensors give it: ``info["measured_state"]`` under
-    :class:`shipgym.envs.wrappers.SensorNoise`, else the env's state."""
+    """The states as the ships' sensors give them, one row per ship:
+    ``info["measured_state"]`` under sensor noise, else the env's states."""
     return info.get("measured_state", info["state"])
 
 
-def _speed_through_water(state: np.ndarray, current: tuple[float, float]) -> float:
-    speed, direction = current
-    psi = state[2]
-    return float(state[IU] - speed * math.cos(direction - psi))
+def _speed_through_water(state: np.ndarray, speed: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Surge speed through the water [m/s] of each ship in a current of ``speed`` toward
+    ``direction``."""
+    return state[:, IU] - speed * np.cos(direction - state[:, 2])
+
+
+def _rows(info: dict[str, Any]) -> dict[str, Any]:
+    """A single env's ``info`` as the vector ``info`` of a batch of one."""
+    return {key: np.asarray(value)[None] for key, value in info.items()}
 
 
 class ZeroPolicy:
     """The neutral command: rudder or azimuth amidships, half the thrust range (action 0)."""
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
-        self.act_dim = env.action_space.shape[0]
+        self.act_dim = env.action_space.shape[-1]
 
     def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         return np.zeros(self.act_dim, dtype=np.float32)
@@ -223,6 +229,13 @@ class ZeroPolicy:
 
 class ClassicPolicy:
     """Base of the classic policies: the nominal ship and the design parameters.
+
+    A classic policy runs a batch of ships: ``reset_vector(env, obs, info)`` with the env (a
+    vector env, or a single env: its task holds the ships) and the ``obs`` and vector ``info``
+    of every ship, then ``act_vector(obs, info)`` returns one action row per ship. Each ship's
+    controllers are the arrays' rows, so a ship's actions depend on its own measurements
+    only. ``reset(env, obs, info)`` and ``act(obs, info)`` run one ship (a single env) as a
+    batch of one.
 
     Parameters
     ----------
@@ -252,6 +265,22 @@ class ClassicPolicy:
         self.nominal = nominal or self.NOMINAL
         self.design: dict[str, Any] = {**self.DESIGN, **design}
 
+    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+        """Start an episode of one ship (a single env): a batch of one."""
+        self.reset_vector(env, np.asarray(obs)[None], _rows(info))
+
+    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        """The action of one ship (a single env)."""
+        return self.act_vector(np.asarray(obs)[None], _rows(info))[0]
+
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+        """Start the episodes of every ship of ``env``'s task."""
+        raise NotImplementedError
+
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        """The actions of every ship, shape ``(n, act_dim)``."""
+        raise NotImplementedError
+
 
 class NomotoHeadingClassic(ClassicPolicy):
     """PID autopilot by pole placement on the ship's Nomoto ``K, T`` (seed 004 eq. 7).
@@ -266,15 +295,14 @@ class NomotoHeadingClassic(ClassicPolicy):
     }  # fmt: skip
     NOMINAL: ClassVar[str] = "nomoto1"
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         model = env.task.model
-        gear = model.gear
-        self.max_angle = gear.max_angle
-        self.dt = env.dt
+        self.max_angle = model.gear.max_angle
+        self.dt = env.task.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
-        self.pilot = self._autopilot(model, env.dt)
+        self.pilot = self._autopilot(model, self.dt)
         state = _measured(info)
-        self.pilot.reset(state[self.ipsi], state[self.ir], t=0.0)
+        self.pilot.reset(state[:, self.ipsi], state[:, self.ir], t=0.0)
         self.t = 0.0
 
     def _autopilot(self, model: Any, dt: float) -> HeadingAutopilot:
@@ -286,12 +314,13 @@ class NomotoHeadingClassic(ClassicPolicy):
         )
         return nomoto_heading_autopilot(nominal, dt, **self.design)
 
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        setpoint = info["heading_setpoint"]
-        delta = self.pilot.update(self.t, state[self.ipsi], state[self.ir], setpoint)
+        delta = self.pilot.update(
+            self.t, state[:, self.ipsi], state[:, self.ir], info["heading_setpoint"]
+        )
         self.t += self.dt
-        return np.array([delta / self.max_angle], dtype=np.float32)
+        return (delta / self.max_angle).astype(np.float32)[:, None]
 
 
 #: ``kind`` of the gains document that ``shipgym design --json`` writes
@@ -482,19 +511,19 @@ class RVGHeadingClassic(ClassicPolicy):
         "omega_n": None, "reference_omega": 0.1, "max_turn_rate": 0.03,
     }  # fmt: skip
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
-        self.dt = env.dt
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+        self.dt = env.task.dt
         self.max_azimuth = env.task.max_azimuth
-        self.pilot = _rvg_heading_autopilot(env.dt, self.max_azimuth, self.nominal, **self.design)
+        self.pilot = _rvg_heading_autopilot(self.dt, self.max_azimuth, self.nominal, **self.design)
         state = _measured(info)
-        self.pilot.reset(state[2], state[IR], t=0.0)
+        self.pilot.reset(state[:, 2], state[:, IR], t=0.0)
         self.t = 0.0
 
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        azimuth = self.pilot.update(self.t, state[2], state[IR], info["heading_setpoint"])
+        azimuth = self.pilot.update(self.t, state[:, 2], state[:, IR], info["heading_setpoint"])
         self.t += self.dt
-        return PodCommand(azimuth, 0.0).to_env_action("heading", max_azimuth=self.max_azimuth)
+        return pod_env_actions(azimuth, 0.0, "heading", max_azimuth=self.max_azimuth)
 
 
 class RVGSpeedClassic(ClassicPolicy):
@@ -505,16 +534,17 @@ class RVGSpeedClassic(ClassicPolicy):
 
     DESIGN: ClassVar[dict[str, float | None]] = {"omega_n": 0.1, "zeta": 1.0}
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
-        self.dt = env.dt
-        self.pilot = _rvg_speed_autopilot(env.dt, self.nominal, **self.design)
-        self.pilot.reset(t=0.0)
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+        self.dt = env.task.dt
+        self.pilot = _rvg_speed_autopilot(self.dt, self.nominal, **self.design)
+        self.pilot.reset(t=0.0, integral=np.zeros(len(obs)))
         self.t = 0.0
 
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        thrust = self.pilot.update(self.t, float(obs[1]), float(obs[3]))
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        obs = np.asarray(obs, dtype=np.float64)
+        thrust = self.pilot.update(self.t, obs[:, 1], obs[:, 3])
         self.t += self.dt
-        return PodCommand(0.0, thrust).to_env_action("speed")
+        return pod_env_actions(0.0, thrust, "speed")
 
 
 class RVGPathClassic(ClassicPolicy):
@@ -535,34 +565,37 @@ class RVGPathClassic(ClassicPolicy):
         super().__init__(nominal, **design)
         self.integral = integral
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         task = env.task
-        self.dt = env.dt
+        self.dt = task.dt
         self.max_azimuth = task.max_azimuth
         d = dict(self.design)
         self.guidance = LOSGuidance(
-            WaypointPath(task.waypoints(0)),
+            [WaypointPath(task.waypoints(i)) for i in range(len(obs))],
             d.pop("lookahead_lengths") * LPP,
             integral=self.integral,
             design_speed=SERVICE_SPEED,
             switching="circle",
             acceptance_radius=task.accept_radius,
         )
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, self.nominal, **d)
-        self.speed = _rvg_speed_autopilot(env.dt, self.nominal, **RVGSpeedClassic.DESIGN)
+        self.heading = _rvg_heading_autopilot(self.dt, task.max_azimuth, self.nominal, **d)
+        self.speed = _rvg_speed_autopilot(self.dt, self.nominal, **RVGSpeedClassic.DESIGN)
         state = _measured(info)
-        self.heading.reset(state[2], state[IR], t=0.0)
-        self.speed.reset(t=0.0)
+        self.heading.reset(state[:, 2], state[:, IR], t=0.0)
+        self.speed.reset(t=0.0, integral=np.zeros(len(obs)))
         self.t = 0.0
 
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        current = (info["current_speed"], info["current_direction"])
-        chi_d = self.guidance.update(self.t, state[:2], state[2], state[IR])
-        azimuth = self.heading.update(self.t, state[2], state[IR], chi_d)
-        thrust = self.speed.update(self.t, _speed_through_water(state, current), SERVICE_SPEED)
+        psi, r = state[:, 2], state[:, IR]
+        chi_d = self.guidance.update(self.t, state[:, :2], psi, r)
+        azimuth = self.heading.update(self.t, psi, r, chi_d)
+        through_water = _speed_through_water(
+            state, info["current_speed"], info["current_direction"]
+        )
+        thrust = self.speed.update(self.t, through_water, SERVICE_SPEED)
         self.t += self.dt
-        return PodCommand(azimuth, thrust).to_env_action("path", max_azimuth=self.max_azimuth)
+        return pod_env_actions(azimuth, thrust, "path", max_azimuth=self.max_azimuth)
 
 
 class RVGTargetClassic(ClassicPolicy):
@@ -582,47 +615,49 @@ class RVGTargetClassic(ClassicPolicy):
         "reference_omega": 0.1, "max_turn_rate": 0.03,
     }  # fmt: skip
 
-    def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
+    def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         task = env.task
-        self.dt = env.dt
+        self.dt = task.dt
         self.max_azimuth = task.max_azimuth
         d = dict(self.design)
         self.guidance = ConstantBearingGuidance(
-            d.pop("approach_speed"), d.pop("delta"), float(task.distance[0]), max_speed=6.0,
-            dt=env.dt,
+            d.pop("approach_speed"), d.pop("delta"), task.distance[: len(obs)].copy(),
+            max_speed=6.0, dt=self.dt,
         )  # fmt: skip
         min_thrust = d.pop("min_thrust")
-        self.heading = _rvg_heading_autopilot(env.dt, task.max_azimuth, self.nominal, **d)
+        self.heading = _rvg_heading_autopilot(self.dt, task.max_azimuth, self.nominal, **d)
         self.speed = _rvg_speed_autopilot(
-            env.dt, self.nominal, **RVGSpeedClassic.DESIGN, design_speed=3.0,
+            self.dt, self.nominal, **RVGSpeedClassic.DESIGN, design_speed=3.0,
             min_thrust=min_thrust,
         )  # fmt: skip
         state = _measured(info)
-        self.heading.reset(state[2], state[IR], t=0.0)
-        self.speed.reset(t=0.0)
+        self.heading.reset(state[:, 2], state[:, IR], t=0.0)
+        self.speed.reset(t=0.0, integral=np.zeros(len(obs)))
         self.t = 0.0
 
-    def act(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        psi = state[2]
-        c, s = math.cos(psi), math.sin(psi)
+        psi = state[:, 2]
+        c, s = np.cos(psi), np.sin(psi)
 
-        def to_ned(a: float, b: float) -> tuple[float, float]:  # body frame -> NED
-            return c * a - s * b, s * a + c * b
+        def to_ned(a: np.ndarray, b: np.ndarray) -> np.ndarray:  # body frame -> NED, (n, 2)
+            # in the precision of the inputs: the float32 observations rotate in float32
+            cc, ss = c.astype(a.dtype), s.astype(a.dtype)
+            return np.stack([cc * a - ss * b, ss * a + cc * b], axis=1)
 
-        rel = to_ned(obs[0], obs[1])  # the target's relative position
-        ship_velocity = to_ned(state[IU], state[IV])
-        rel_velocity = to_ned(obs[2], obs[3])
-        target = (state[0] + rel[0], state[1] + rel[1])
-        target_velocity = (ship_velocity[0] + rel_velocity[0], ship_velocity[1] + rel_velocity[1])
-        chi_d, u_d = self.guidance.update(self.t, state[:2], target, target_velocity)
+        obs = np.asarray(obs)
+        target = state[:, :2] + to_ned(obs[:, 0], obs[:, 1])  # the target's relative position
+        ship_velocity = to_ned(state[:, IU], state[:, IV])
+        target_velocity = ship_velocity + to_ned(obs[:, 2], obs[:, 3])
+        chi_d, u_d = self.guidance.update(self.t, state[:, :2], target, target_velocity)
         # the guidance asks for a course and speed over ground: steer the heading that gives
         # that course with the measured sideslip (current, drift), and hold the ground speed
-        crab = math.atan2(ship_velocity[1], ship_velocity[0]) - psi
-        azimuth = self.heading.update(self.t, psi, state[IR], chi_d - crab)
-        thrust = self.speed.update(self.t, math.hypot(*ship_velocity), u_d)
+        course, speed = course_and_speed(ship_velocity)
+        crab = course - psi
+        azimuth = self.heading.update(self.t, psi, state[:, IR], chi_d - crab)
+        thrust = self.speed.update(self.t, speed, u_d)
         self.t += self.dt
-        return PodCommand(azimuth, thrust).to_env_action("target", max_azimuth=self.max_azimuth)
+        return pod_env_actions(azimuth, thrust, "target", max_azimuth=self.max_azimuth)
 
 
 #: The classic policy of each task.

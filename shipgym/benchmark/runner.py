@@ -16,9 +16,9 @@ controller). Conditions:
   (:data:`MISMATCH_SHIPS`: the nonlinear Bech and Norrbin Mariners for the first-order Nomoto
   env; the other Gunnerus parameter set for the Gunnerus envs), one result per ship, labelled
   ``mismatch:<ship>``;
-* ``noise``: :class:`~shipgym.envs.wrappers.SensorNoise` at its default levels (heading 0.5
+* ``noise``: :class:`~shipgym.envs.wrappers.VectorSensorNoise` at its default levels (heading 0.5
   deg, yaw rate 0.1 deg/s, speed 0.1 m/s, position 1 m);
-* ``delay``: :class:`~shipgym.envs.wrappers.ActuatorDelay` of :data:`ACTUATOR_DELAY_STEPS`
+* ``delay``: :class:`~shipgym.envs.wrappers.VectorActuatorDelay` of :data:`ACTUATOR_DELAY_STEPS`
   control steps (1 s on the Gunnerus, 2 s on the Mariner).
 
 The ``zero`` command, a baseline, runs in the nominal condition only. The default first seed,
@@ -49,6 +49,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+from gymnasium.vector import VectorEnv
 
 from shipgym.benchmark.evaluate import (
     METRICS,
@@ -59,7 +60,7 @@ from shipgym.benchmark.evaluate import (
 )
 from shipgym.benchmark.policies import POLICIES, make_policy
 from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS, env_task
-from shipgym.envs.wrappers import ActuatorDelay, SensorNoise
+from shipgym.envs.wrappers import VectorActuatorDelay, VectorSensorNoise
 from shipgym.rl.train import BENCHMARK_SEED
 
 CONTROLLERS = ("classic", "classic-tuned", "ppo", "sac", "zero")
@@ -105,8 +106,14 @@ class Scenario:
     label: str
     env_kwargs: dict[str, Any] | None = None
     reset_options: dict[str, Any] | None = None
-    wrappers: tuple[Callable[[gym.Env], gym.Env], ...] = ()
+    wrappers: tuple[Callable[[VectorEnv], VectorEnv], ...] = ()
     design_model: str | None = None
+
+
+def delayed(env: VectorEnv) -> VectorEnv:
+    """``env`` behind the delay condition's actuator delay: :data:`ACTUATOR_DELAY_STEPS`
+    control steps (:class:`~shipgym.envs.wrappers.VectorActuatorDelay`)."""
+    return VectorActuatorDelay(env, ACTUATOR_DELAY_STEPS * env.unwrapped.task.dt)
 
 
 def scenarios(env_id: str, condition: str, stress_current: float) -> list[Scenario]:
@@ -121,14 +128,26 @@ def scenarios(env_id: str, condition: str, stress_current: float) -> list[Scenar
             for label, kwargs in MISMATCH_SHIPS[env_id].items()
         ]
     if condition == "noise":
-        return [Scenario("noise", wrappers=(SensorNoise,))]
+        return [Scenario("noise", wrappers=(VectorSensorNoise,))]
     if condition == "delay":
-
-        def delayed(env: gym.Env) -> gym.Env:
-            return ActuatorDelay(env, ACTUATOR_DELAY_STEPS * env.unwrapped.dt)
-
         return [Scenario("delay", wrappers=(delayed,))]
     raise ValueError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
+
+
+def benchmark_cells(
+    envs: Sequence[str], controllers: Sequence[str], conditions: Sequence[str]
+) -> list[tuple[str, str, str]]:
+    """The cells of a benchmark, in table order: ``(env, condition, scenario label)`` of each
+    scenario and each controller (the baselines of :data:`NOMINAL_ONLY` in the nominal
+    condition only), as ``(env, condition, label, controller)``."""
+    return [
+        (env_id, condition, scenario.label, name)
+        for env_id in envs
+        for condition in conditions
+        for scenario in scenarios(env_id, condition, 0.0)
+        for name in controllers
+        if scenario.label == "nominal" or name not in NOMINAL_ONLY
+    ]
 
 
 @dataclass
@@ -488,7 +507,7 @@ def evaluate_on_ray(
     env_kwargs: dict[str, Any] | None = None,
     reset_options: dict[str, Any] | None = None,
     condition: str = "nominal",
-    wrappers: Sequence[Callable[[gym.Env], gym.Env]] = (),
+    wrappers: Sequence[Callable[[VectorEnv], VectorEnv]] = (),
     agents_dir: str | Path | None = None,
     keep_logs: int | None = None,
     progress: Callable[[str], None] | None = None,
@@ -628,13 +647,9 @@ def run_benchmark(
                 )
     stress_current = {env_id: STRESS_FACTOR * training_max_current(env_id) for env_id in envs}
     cells = [
-        (env_id, condition, scenario.label, stress_current[env_id], name, episodes, seed,
-         agents_dir, keep_logs)
-        for env_id in envs
-        for condition in conditions
-        for scenario in scenarios(env_id, condition, stress_current[env_id])
-        for name in controllers
-        if scenario.label == "nominal" or name not in NOMINAL_ONLY
+        (env_id, condition, label, stress_current[env_id], name, episodes, seed, agents_dir,
+         keep_logs)
+        for env_id, condition, label, name in benchmark_cells(envs, controllers, conditions)
     ]  # fmt: skip
     results: list[EvaluationResult] = []
 

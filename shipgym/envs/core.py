@@ -11,26 +11,77 @@ autoreset of any number of sub-envs draws for all of them in one compiled pass.
 
 The vector env behaves as Gymnasium's ``SyncVectorEnv`` of single envs, ``info`` included
 (the same keys, ``_key`` flags, dtypes and values; :meth:`Task.batch_info` builds it for all
-sub-envs with NumPy), in both autoreset modes: next-step (the default) and same-step
+sub-envs with NumPy), in Gymnasium's three autoreset modes: next-step (the default), same-step
 (``autoreset_mode=AutoresetMode.SAME_STEP``: the finished episode's last observation and info
 in ``info["final_obs"]`` and ``info["final_info"]``, the form that stable-baselines3's
-``VecEnv`` needs, :mod:`shipgym.rl.vec_env`). ``keep_options=True`` makes autoresets use the
-options of the last ``reset(options=...)``, which ``SyncVectorEnv`` forgets.
+``VecEnv`` needs, :mod:`shipgym.rl.vec_env`) and disabled (``AutoresetMode.DISABLED``, the
+manual mode: the caller resets finished sub-envs with ``reset(options={"reset_mask": mask})``).
+``reset_mask`` resets only the flagged sub-envs in every mode, as in ``SyncVectorEnv``.
+``keep_options=True`` makes autoresets use the options of the last ``reset(options=...)``,
+which ``SyncVectorEnv`` forgets.
+
+Where ``SyncVectorEnv`` refuses to step a finished sub-env in disabled mode, this env *parks*
+it: until a reset, a step leaves it as it ended (its action is ignored, even a NaN; the same
+observation, reward 0, both flags False, its ``info`` entries unflagged), and only the other
+sub-envs go through the kernel. A batch of episodes of different lengths can so be stepped to
+the end of the longest without starting new episodes (an evaluation).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from shipgym.envs.kernels import REASONS, available_threads
 from shipgym.envs.streams import RowStreams
 from shipgym.envs.tasks import Task
+
+#: The autoreset modes of :class:`ShipVectorEnv`.
+AUTORESET_MODES = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP, AutoresetMode.DISABLED)
+
+
+def sub_env_seeds(seed: int | Sequence[int | None] | None, num_envs: int) -> list[int | None]:
+    """The seed of each sub-env for a vector ``reset(seed=seed)``, as ``SyncVectorEnv`` reads
+    it: ``None`` for none of them, ``[s, s + 1, ...]`` for an int ``s``, a list as it is.
+
+    Raises
+    ------
+    ValueError
+        If a list does not have ``num_envs`` entries.
+    """
+    if seed is None:
+        return [None] * num_envs
+    if isinstance(seed, list | tuple):
+        if len(seed) != num_envs:
+            raise ValueError(f"seed list must have {num_envs} entries, got {len(seed)}")
+        return list(seed)
+    return [seed + i for i in range(num_envs)]
+
+
+def reset_rows_of(options: Mapping[str, Any] | None, num_envs: int) -> np.ndarray:
+    """The sub-envs a vector ``reset(options=options)`` resets: those of
+    ``options["reset_mask"]`` (checked as the native env checks it), else all of them."""
+    if options is None or not isinstance(options, Mapping) or "reset_mask" not in options:
+        return np.arange(num_envs)
+    mask = options["reset_mask"]
+    if (
+        not isinstance(mask, np.ndarray)
+        or mask.dtype != np.bool_
+        or mask.shape != (num_envs,)
+        or not mask.any()
+    ):
+        raise ValueError(
+            f"options['reset_mask'] must be a numpy bool array of shape ({num_envs},) with at "
+            f"least one True, got {mask!r}"
+        )
+    return np.flatnonzero(mask)
 
 
 def _bad_action(action: Any, expected: int, reason: str) -> ValueError:
@@ -181,8 +232,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     """NumPy-batched vector env over the same task kernel as the single env.
 
     Equivalent to Gymnasium's ``SyncVectorEnv`` of the single env (``gymnasium.make_vec(id,
-    num_envs, vectorization_mode="sync")``) in observations, rewards, flags and ``info``, but
-    one kernel call steps every sub-env.
+    num_envs, vectorization_mode="sync")``) in observations, rewards, flags and ``info``, in
+    every autoreset mode, but one kernel call steps every sub-env.
 
     Parameters
     ----------
@@ -200,6 +251,14 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         finished episode's last observation and ``info`` are in ``info["final_obs"]`` and
         ``info["final_info"]`` (rows flagged by ``info["_final_obs"]`` and
         ``info["_final_info"]``), the form stable-baselines3 needs (:mod:`shipgym.rl.vec_env`).
+        ``AutoresetMode.DISABLED`` (also ``"Disabled"``): no autoreset; the caller resets the
+        sub-envs that ended with ``reset(options={"reset_mask": mask})``. A sub-env that ended
+        and was not reset is *parked*: ``step`` does not advance it (its action is ignored,
+        even a NaN), returns its last observation again with reward 0 and both flags False,
+        and leaves its ``info`` entries unflagged (zero, None for strings), so a batch of
+        episodes of different lengths runs to the end of the longest without new episodes
+        (``SyncVectorEnv`` refuses to step such a sub-env). Only the sub-envs still running
+        go through the kernel, with bitwise the results of stepping all.
     num_threads : int or None
         Threads that step the batch. 1 (the default) steps it on the calling thread, which is
         the fastest choice whenever the cores are shared: with other busy processes (an RL
@@ -238,6 +297,12 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     ``env.reset()``'s info would); in same-step mode the finished episode's are in
     ``final_info``, whose entries of sub-envs that did not finish are zero (None for strings).
     The arrays are built with NumPy for all sub-envs at once and are new at every call.
+
+    ``reset(options={"reset_mask": mask, ...})`` (every mode) resets only the sub-envs flagged
+    by ``mask`` (a numpy bool array of shape ``(num_envs,)``, at least one True), sub-env ``i``
+    with ``seed[i]`` of a seed list or ``seed + i`` of an int seed, and the other options;
+    the other sub-envs keep their episode and observation, and the ``info`` flags the reset
+    sub-envs only (the others' entries zero, None for strings), as ``SyncVectorEnv`` does.
     """
 
     metadata: ClassVar[dict[str, Any]] = {
@@ -269,20 +334,21 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
                 f"num_threads must be an integer in [1, {max_threads}] (the CPUs this process "
                 f"may run on) or None for all of them, got {num_threads!r}"
             )
-        modes = (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP)
         try:
             mode = AutoresetMode(autoreset_mode)
         except ValueError:
             mode = None
-        if mode not in modes:
+        if mode not in AUTORESET_MODES:
             raise ValueError(
-                f"autoreset_mode must be one of {[m.value for m in modes]}, got {autoreset_mode!r}"
+                f"autoreset_mode must be one of {[m.value for m in AUTORESET_MODES]}, "
+                f"got {autoreset_mode!r}"
             )
         for name, flag in (("keep_options", keep_options), ("step_info", step_info)):
             if not isinstance(flag, bool | np.bool_):
                 raise ValueError(f"{name} must be True or False, got {flag!r}")
         self.step_info = bool(step_info)
         self.autoreset_mode = mode
+        self._parks = mode is AutoresetMode.DISABLED  # (a flag read at every step)
         self.keep_options = bool(keep_options)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
         self.task = self.task_cls(num_envs, **task_kwargs)
@@ -305,6 +371,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         #: the random stream of each sub-env (Gymnasium's ``np_random``, held as arrays)
         self._streams = RowStreams(self.num_envs)
+        #: sub-envs that ended at their last step and have not been reset since
         self._prev_done = np.zeros(self.num_envs, dtype=np.bool_)
         #: Options of the autoresets: those of the last reset with ``keep_options``, else None.
         self._autoreset_options: dict[str, Any] | None = None
@@ -332,6 +399,18 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             info[f"_{key}"] = flag
         return info
 
+    def _flagged_info(self, flags: np.ndarray) -> dict[str, Any]:
+        """The vector ``info`` of the sub-envs flagged by ``flags``, as ``SyncVectorEnv`` builds
+        it from theirs alone: the other sub-envs' entries zero (None for objects), every
+        ``_key`` a copy of ``flags``."""
+        info = self.task.batch_info()
+        others = ~flags
+        for key in tuple(info):
+            value = info[key]
+            value[others] = None if value.dtype == object else 0
+            info[f"_{key}"] = flags.copy()
+        return info
+
     def _final(self, obs: np.ndarray, done: np.ndarray) -> dict[str, Any]:
         """``final_obs`` and ``final_info`` of the sub-envs flagged by ``done`` (before their
         reset), as ``SyncVectorEnv`` builds them: object array of observations, nested info
@@ -343,12 +422,7 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             final_obs[i] = obs[i]
         if not self.step_info:
             return {"final_obs": final_obs, "_final_obs": done.copy()}
-        final_info = self.task.batch_info()
-        running = ~done
-        for key in tuple(final_info):
-            value = final_info[key]
-            value[running] = None if value.dtype == object else 0
-            final_info[f"_{key}"] = done.copy()
+        final_info = self._flagged_info(done)
         return {
             "final_obs": final_obs,
             "_final_obs": done.copy(),
@@ -357,27 +431,71 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         }
 
     def reset(
-        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+        self,
+        *,
+        seed: int | list[int | None] | None = None,
+        options: dict[str, Any] | None = None,
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        """Reset every sub-env; ``options`` as for the single env, for every sub-env.
+        """Reset every sub-env, or those of ``options["reset_mask"]``; the other options as for
+        the single env, for every sub-env reset.
 
-        Whether the autoresets that follow use ``options`` too is ``keep_options``.
+        Sub-env ``i`` is seeded with ``seed + i`` (an int seed) or ``seed[i]`` (a list; a None
+        entry, like ``seed=None``, continues its random stream). Whether the autoresets that
+        follow use the options too is ``keep_options``.
+
+        Raises
+        ------
+        ValueError
+            For a bad ``reset_mask`` (a numpy bool array of shape ``(num_envs,)`` with at least
+            one True is expected), a seed list of another length or a bad option; no episode
+            changes then (after a bad option, the random streams of the sub-envs to reset are
+            seeded and drawn from, as the single env's).
+        gymnasium.error.ResetNeeded
+            For a ``reset_mask`` that leaves out sub-envs before the first full reset.
         """
         self._check_open("reset", needs_reset=False)
-        if seed is not None:
-            seeds = (
-                list(seed)
-                if isinstance(seed, list | tuple)
-                else [seed + i for i in range(self.num_envs)]
-            )
-            if len(seeds) != self.num_envs:
-                raise ValueError(f"seed list must have {self.num_envs} entries, got {len(seeds)}")
-            self._streams = RowStreams(self.num_envs, seeds)  # a bad seed changes nothing
-        self.task.reset_rows(np.arange(self.num_envs), self._streams, options)
+        rows = reset_rows_of(options, self.num_envs)
+        if isinstance(options, Mapping) and "reset_mask" in options:
+            if self._needs_reset and rows.size < self.num_envs:
+                raise gym.error.ResetNeeded(
+                    "Cannot reset some sub-envs with reset_mask before every sub-env has been "
+                    "reset; call env.reset() first"
+                )
+            options = {k: v for k, v in options.items() if k != "reset_mask"}
+        seeds = sub_env_seeds(seed, self.num_envs)
+        seeded = [(i, seeding.np_random(seeds[i])[0]) for i in rows if seeds[i] is not None]
+        for i, generator in seeded:  # (made first: a bad seed changes nothing)
+            self._streams.set_generator(i, generator)
+        self.task.reset_rows(rows, self._streams, options)
         self._autoreset_options = dict(options) if self.keep_options and options else None
-        self._prev_done[:] = False
+        self._prev_done[rows] = False
         self._needs_reset = False
-        return self.task.obs.astype(np.float32), self._info()
+        if rows.size == self.num_envs:
+            return self.task.obs.astype(np.float32), self._info()
+        if not self.step_info:
+            return self.task.obs.astype(np.float32), {}
+        flags = np.zeros(self.num_envs, dtype=np.bool_)
+        flags[rows] = True
+        return self.task.obs.astype(np.float32), self._flagged_info(flags)
+
+    @property
+    def ended(self) -> np.ndarray:
+        """Which sub-envs ended (terminated or truncated) at their last step and have not been
+        reset since (a copy): the next ``step`` resets them in next-step mode and leaves them
+        parked in disabled mode; none in same-step mode. Wrappers read it before a step."""
+        return self._prev_done.copy()
+
+    def draw_integers(self, rows: Sequence[int] | np.ndarray, high: int) -> list[int]:
+        """One integer in ``[0, high)`` from the random stream of each sub-env of ``rows``,
+        exactly as ``env.np_random.integers(high)`` draws it in the single env that sub-env
+        equals, and advancing the stream as that draw does: how a wrapper seeds its own
+        generator of a sub-env reset without a seed, as its single-env twin does."""
+        values = []
+        for i in rows:
+            generator = self._streams.generator(int(i))
+            values.append(int(generator.integers(high)))
+            self._streams.set_generator(int(i), generator)
+        return values
 
     def _autoreset(self, rows: np.ndarray) -> None:
         self.task.reset_rows(rows, self._streams, self._autoreset_options)
@@ -388,6 +506,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._check_open("step")
         task = self.task
         task.a[:] = _checked_shape(actions, task.a.shape, task.act_dim)
+        if self._parks and self._prev_done.any():
+            return self._step_live(actions)
         bad = task.step()
         if bad >= 0:
             raise _bad_action(
@@ -405,13 +525,35 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             info = self._info()
             info.update(final)
             return task.obs.astype(np.float32), rewards, terminated, truncated, info
-        if self._prev_done.any():
+        if self._prev_done.any():  # (none in disabled mode: parked sub-envs step elsewhere)
             self._autoreset(np.flatnonzero(self._prev_done))
             rewards[self._prev_done] = 0.0
             terminated[self._prev_done] = False
             truncated[self._prev_done] = False
         self._prev_done = terminated | truncated
         return task.obs.astype(np.float32), rewards, terminated, truncated, self._info()
+
+    def _step_live(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """A disabled-mode step with parked sub-envs (``_prev_done``): only the others go
+        through the kernel; the parked ones' actions are zeroed so that only live actions are
+        checked."""
+        task = self.task
+        parked = self._prev_done
+        live = ~parked
+        task.a[parked] = 0.0
+        bad = task.step(np.flatnonzero(live))
+        if bad >= 0:
+            raise _bad_action(
+                actions[bad], task.act_dim, f"sub-env {bad}'s action holds NaN or infinity"
+            )
+        terminated = task.term & live
+        truncated = (task.steps >= self.max_episode_steps) & live
+        rewards = np.where(live, task.rew, 0.0)
+        self._prev_done = parked | terminated | truncated
+        info = self._flagged_info(live) if self.step_info else {}
+        return task.obs.astype(np.float32), rewards, terminated, truncated, info
 
     def render(self) -> np.ndarray | None:
         """Top-down view of sub-env 0 (``rgb_array`` only)."""

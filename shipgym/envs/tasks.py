@@ -306,15 +306,39 @@ class Task:
             self.obs_high,
         )
 
-    def step(self) -> int:
-        """Step every row with the actions in ``self.a``; returns a bad action row or -1."""
+    def step(self, rows: np.ndarray | None = None) -> int:
+        """Step every row, or only ``rows``, with the actions in ``self.a``.
+
+        Parameters
+        ----------
+        rows : numpy.ndarray of int64, optional
+            Distinct row indices in ``[0, n)`` to step; the others keep their state,
+            observation, reward and flags. Each stepped row's result is bitwise the one of
+            stepping every row. The actions of every row are checked (set the others' to 0).
+
+        Returns
+        -------
+        int
+            The first row whose action holds a NaN or infinity (then no row is stepped), or -1.
+        """
+        if rows is not None:
+            # the compiled call takes exactly the types it was built for (a C-contiguous int64
+            # vector) and does not check the indices
+            rows = np.ascontiguousarray(rows, dtype=np.int64)
+            if rows.ndim != 1 or (rows.size and not 0 <= rows.min() <= rows.max() < self.n):
+                raise ValueError(
+                    f"rows must be a vector of row indices in [0, {self.n}), got {rows!r}"
+                )
         if self._step_call is None:  # built once: every array is updated in place
             self._step_args = self._args(True, np.arange(self.n))
             self._step_call = kernels.compiled_call(self._kernel(self.n), self._step_args)
         if self.delay is not None and np.isfinite(self.a).all():  # (a bad action steps no row)
             np.clip(self.a, -1.0, 1.0, out=self.a)
             self.a[:] = self.delay.push(self.a)
-        return self._step_call(*self._step_args)
+        if rows is None:
+            return self._step_call(*self._step_args)
+        advance, _, *rest = self._step_args
+        return self._step_call(advance, rows, *rest)
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()

@@ -4,12 +4,19 @@ Every model and task kernel is a Numba ``njit`` function, so the same compiled c
 single environment, the vector environment, the manoeuvres and system identification
 (ARCHITECTURE.md, "One physics, many users").
 
-Compiled code is cached on disk in a directory keyed by a hash of every source that holds
-kernels (``shipgym/models/*.py`` and ``shipgym/envs/kernels.py``):
-Numba alone only invalidates a cached function when its own file changes, and a kernel that
-inlines a changed kernel from another file would otherwise load stale machine code. The
-directory is ``$SHIPGYM_CACHE_DIR`` or ``~/.cache/shipgym/numba-<hash>``; set
-``SHIPGYM_NO_CACHE=1`` to compile without any cache.
+Compiled code is cached on disk in one folder per version of the kernels,
+``$SHIPGYM_CACHE_DIR/numba-<key>`` (``~/.cache/shipgym/numba-<key>`` by default), where the key is
+a hash of the content of every source the kernels depend on (each module of the ``shipgym`` and
+``controllers`` packages that imports this one, this one, and the project's modules they import)
+and of the Python, Numba, llvmlite and NumPy versions. Inside it a kernel's entry is found by its
+module's name and is fresh while its source file's content is unchanged
+(:class:`_ContentLocator`). Numba's own
+locators file an entry under a hash of the source folder's absolute path, so a checkout and an
+installed copy of the same code (the test suite and the command line) would each compile every
+kernel; here they share one entry. And Numba alone only invalidates a cached function when its
+own file changes, so a kernel that inlines a changed kernel from another file would load stale
+machine code; the key over all kernel sources rules that out. Set ``SHIPGYM_NO_CACHE=1`` to
+compile without any cache.
 
 A cache entry that cannot be read (an empty file left by a full disk or a killed process, a
 garbled or foreign file) repairs itself: the function's index and data files are removed with a
@@ -23,15 +30,18 @@ from __future__ import annotations
 import glob
 import hashlib
 import os
+import re
+import sys
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, ClassVar, TypeVar
 
 import llvmlite.binding as llvm
 import numba
 import numpy as np
-from numba.core.caching import FunctionCache
+from llvmlite import __version__ as llvm_version
+from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
 from numba.extending import overload
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -67,19 +77,111 @@ def _prefer_wide_vectors() -> None:
 _prefer_wide_vectors()
 
 
+#: how a module that defines kernels imports the decorators (the text searched for)
+_KERNEL_IMPORT = re.compile(rb"^from shipgym\.models\._jit import", re.MULTILINE)
+#: an import of the project's modules: ``from a.b import c, d`` (the names maybe in
+#: parentheses over several lines) or ``import a.b``
+_PROJECT_IMPORT = re.compile(
+    rb"^(?:from\s+((?:shipgym|controllers)[\w.]*)\s+import\s+(?:\(([^)]*)\)|([\w \t,]*))"
+    rb"|import\s+((?:shipgym|controllers)[\w.]*))",
+    re.MULTILINE,
+)
+
+
+def _module_file(site: Path, name: str) -> Path | None:
+    """The source file of module ``name`` under ``site`` (None: not a module there)."""
+    base = site.joinpath(*name.split("."))
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+def _kernel_sources(site: Path) -> list[Path]:
+    """The source files of the ``shipgym`` and ``controllers`` packages under ``site`` that the
+    compiled kernels depend on: every module that imports this module's decorators, this
+    module, and every module of the project they import, directly or not (a kernel compiles in
+    the values of the globals it reads, such as an imported constant)."""
+    todo = [Path(__file__).resolve()]
+    for package in ("shipgym", "controllers"):
+        todo += [p for p in (site / package).rglob("*.py") if _KERNEL_IMPORT.search(p.read_bytes())]
+    found: set[Path] = set()
+    while todo:
+        path = todo.pop()
+        if path in found:
+            continue
+        found.add(path)
+        for module, listed, names, plain in _PROJECT_IMPORT.findall(path.read_bytes()):
+            if plain:
+                candidates = [plain.decode()]
+            else:
+                module = module.decode()
+                names = (listed or names).decode().replace(",", " ").split()
+                candidates = [module, *(f"{module}.{n}" for n in names)]
+            todo += [f for c in candidates if (f := _module_file(site, c)) is not None]
+    return sorted(found)
+
+
 def _cache_dir() -> str:
-    root = Path(__file__).resolve().parents[1]
-    digest = hashlib.sha1(numba.__version__.encode())
-    for path in sorted([*root.glob("models/*.py"), root / "envs" / "kernels.py"]):
-        digest.update(path.relative_to(root).as_posix().encode())
-        digest.update(path.read_bytes())
+    """The cache folder of this version of the kernels (see the module docstring)."""
+    site = Path(__file__).resolve().parents[2]  # the folder holding the shipgym package
+    digest = hashlib.sha256()
+    for version in (sys.version_info[:2], numba.__version__, llvm_version, np.__version__):
+        digest.update(f"{version}\n".encode())
+    for path in _kernel_sources(site):
+        digest.update(path.relative_to(site).as_posix().encode() + b"\n")
+        digest.update(hashlib.sha256(path.read_bytes()).digest())
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return os.environ.get("SHIPGYM_CACHE_DIR") or os.path.join(
-        base, "shipgym", f"numba-{digest.hexdigest()[:16]}"
-    )
+    root = os.environ.get("SHIPGYM_CACHE_DIR") or os.path.join(base, "shipgym")
+    return os.path.join(root, f"numba-{digest.hexdigest()[:16]}")
 
 
-_CACHE_DIR = _cache_dir() if _CACHE else ""
+CACHE_DIR = _cache_dir() if _CACHE else ""
+"""The kernel cache folder of this version of the kernels ("" when ``SHIPGYM_NO_CACHE`` is set)."""
+
+
+class _ContentLocator(_CacheLocator):
+    """Numba's locator of a kernel's cache entry, keyed by content rather than by path.
+
+    The entry lives in ``CACHE_DIR/<module name>`` and is fresh while the SHA-256 of the source
+    file is unchanged: two copies of the same module at different paths share it (Numba's own
+    locators use a hash of the folder's absolute path and, before Numba 0.68, the file's
+    modification time).
+    """
+
+    def __init__(self, py_func: Callable[..., Any], py_file: str) -> None:
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = os.path.join(CACHE_DIR, py_func.__module__)
+
+    def get_cache_path(self) -> str:
+        return self._cache_path
+
+    def get_source_stamp(self) -> str:
+        return hashlib.sha256(Path(self._py_file).read_bytes()).hexdigest()
+
+    def get_disambiguator(self) -> str:
+        return str(self._lineno)
+
+    @classmethod
+    def from_function(cls, py_func: Callable[..., Any], py_file: str) -> _ContentLocator | None:
+        if not os.path.isfile(py_file):
+            return None
+        self = cls(py_func, py_file)
+        try:
+            self.ensure_cache_path()
+        except OSError:  # not writable: Numba's own locators are tried next
+            return None
+        return self
+
+
+class _ContentKeyedImpl(CompileResultCacheImpl):
+    """Numba's compile-result cache with :class:`_ContentLocator` tried first."""
+
+    _locator_classes: ClassVar[list[type[_CacheLocator]]] = [
+        _ContentLocator,
+        *CompileResultCacheImpl._locator_classes,
+    ]
 
 
 class _SelfRepairingCache(FunctionCache):
@@ -90,6 +192,8 @@ class _SelfRepairingCache(FunctionCache):
     cache files with a warning and reports a miss, so Numba compiles the kernel and saves a
     fresh entry in their place.
     """
+
+    _impl_class = _ContentKeyedImpl
 
     def _repair(self, exc: BaseException) -> None:
         cache_file = self._cache_file
@@ -129,16 +233,10 @@ class _SelfRepairingCache(FunctionCache):
 
 
 def _compile(func: F, **options: Any) -> F:
-    if not _CACHE:
-        return numba.njit(**options)(func)  # type: ignore[return-value]
-    previous = numba.config.CACHE_DIR
-    numba.config.CACHE_DIR = _CACHE_DIR  # read once, when the dispatcher sets up its cache
-    try:
-        dispatcher = numba.njit(cache=True, **options)(func)
+    dispatcher = numba.njit(**options)(func)
+    if _CACHE:
         dispatcher._cache = _SelfRepairingCache(dispatcher.py_func)
-        return dispatcher  # type: ignore[return-value]
-    finally:
-        numba.config.CACHE_DIR = previous
+    return dispatcher  # type: ignore[return-value]
 
 
 def kernel(func: F) -> F:

@@ -437,12 +437,13 @@ class RVGParams:
         """``M = M_rb + M_a``."""
         return self.rigid_body_mass + self.added_mass
 
-    def max_thrust(self, relative_surge: float) -> float:
+    def max_thrust(self, relative_surge: float | np.ndarray) -> float | np.ndarray:
         """Per-pod thrust limit [N] at relative surge speed ``u_r`` [m/s] (advance speed
-        ``(1 - w) u_r``)."""
+        ``(1 - w) u_r``); a float, or an array for an array of speeds."""
         ua = (1.0 - self.wake_fraction) * relative_surge
-        factor = min(max(1.0 - ua / self.thrust_zero_speed, 0.0), 1.0)
-        return self.bollard_thrust * factor
+        factor = np.minimum(np.maximum(1.0 - ua / self.thrust_zero_speed, 0.0), 1.0)
+        limit = self.bollard_thrust * factor
+        return limit if np.ndim(limit) else float(limit)
 
 
 # Parameter-vector layout for the kernel.

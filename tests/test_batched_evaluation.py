@@ -1,0 +1,58 @@
+"""Batched evaluation gives the numbers of the episode-by-episode evaluation it replaced.
+
+``tests/data/benchmark_cells_reference.json`` holds, for every cell of the default benchmark
+(each env, controller and condition), the per-episode returns, metrics, lengths and
+termination reasons of the first four benchmark seeds as the evaluation of commit 0868dfb
+computed them: one single env (``gymnasium.make``) stepped episode after episode, the classic
+controllers on Python floats, one ``info`` dict logged per step. It was written by running
+``_cell_batch(...).run()`` of ``shipgym.benchmark.runner`` for every cell at that commit and
+keeping ``to_dict()``'s ``returns``, ``per_episode``, ``termination`` and ``length``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from shipgym.benchmark.runner import STRESS_FACTOR, _cell_batch, training_max_current
+from shipgym.envs import CURRENT_ENV_IDS
+from shipgym.rl.train import BENCHMARK_SEED
+
+REFERENCE = json.loads(
+    (Path(__file__).parent / "data" / "benchmark_cells_reference.json").read_text()
+)["cells"]
+EPISODES = len(REFERENCE[0]["returns"])
+
+
+def _same(got: list[float], want: list[float], what: str) -> None:
+    got_a = np.asarray(got, dtype=float)
+    want_a = np.asarray(want, dtype=float)
+    assert got_a.shape == want_a.shape, what
+    assert np.array_equal(np.isnan(got_a), np.isnan(want_a)), what
+    assert np.array_equal(got_a, want_a, equal_nan=True), (
+        f"{what}: {got_a.tolist()} != {want_a.tolist()}"
+    )
+
+
+@pytest.mark.parametrize("env_id", CURRENT_ENV_IDS)
+def test_every_benchmark_cell_gives_the_reference_numbers(env_id: str) -> None:
+    stress = STRESS_FACTOR * training_max_current(env_id)
+    cells = [c for c in REFERENCE if c["env"] == env_id]
+    assert cells
+    for ref in cells:
+        label = ref["condition"]
+        result = _cell_batch(
+            env_id, label.split(":")[0], label, stress, ref["controller"], EPISODES,
+            BENCHMARK_SEED, None, 0,
+        ).run()  # fmt: skip
+        what = f"{env_id} {ref['controller']} {label}"
+        assert result.lengths == ref["length"], what
+        assert result.terminations == ref["termination"], what
+        _same(result.returns, ref["returns"], f"{what} returns")
+        for key, values in ref["per_episode"].items():
+            _same(result.values(key).tolist(), values, f"{what} {key}")
+        assert not any(math.isnan(r) for r in result.returns) or result.blown_up, what
