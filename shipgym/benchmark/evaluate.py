@@ -49,6 +49,7 @@ count (``blown_up``) and each episode's termination reason and length in steps.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import sys
@@ -244,9 +245,13 @@ class EvaluationResult:
         episode)."""
         return {k: int(np.isfinite(self.values(k)).sum()) for k in METRICS[self.env]}
 
-    @property
+    @functools.cached_property
     def metrics_ci95(self) -> dict[str, list[float] | None]:
-        """Bootstrap 95 % interval of each metric's mean (``None`` below two values)."""
+        """Bootstrap 95 % interval of each metric's mean (``None`` below two values).
+
+        Computed on first use and kept (a result does not change after its evaluation): the
+        JSON, the CSV and the figures read the same intervals.
+        """
         out: dict[str, list[float] | None] = {}
         for k in METRICS[self.env]:
             v = self.values(k)
@@ -254,13 +259,19 @@ class EvaluationResult:
             out[k] = list(bootstrap_ci(v)) if defined else None
         return out
 
+    @functools.cached_property
+    def return_ci95(self) -> list[float] | None:
+        """Bootstrap 95 % interval of the mean return (``None`` for one episode or a blow-up);
+        computed on first use and kept, as :attr:`metrics_ci95`."""
+        valid = self.episodes > 1 and not self.blown_up
+        return list(bootstrap_ci(self.returns)) if valid else None
+
     def to_dict(self) -> dict[str, Any]:
         """The JSON object: env, controller, condition, episodes, mean/std return and its
         bootstrap 95 % interval, each metric's mean, std, interval and number of episodes
         that define it, the per-episode returns and metrics (for paired comparisons), each
         episode's termination reason and length, and the number of blown-up episodes (every
         aggregate is NaN if there is one)."""
-        valid = self.episodes > 1 and not self.blown_up
         return {
             "env": self.env,
             "controller": self.controller,
@@ -269,7 +280,7 @@ class EvaluationResult:
             "seed": self.seed,
             "mean_return": self.mean_return,
             "std_return": float(np.std(self.returns)) if not self.blown_up else math.nan,
-            "return_ci95": list(bootstrap_ci(self.returns)) if valid else None,
+            "return_ci95": self.return_ci95,
             "blown_up": self.blown_up,
             "metrics": self.metrics,
             "metrics_std": self.metrics_std,
@@ -440,17 +451,17 @@ def _row_info(info: dict[str, Any], k: int) -> dict[str, Any]:
 def _act_in_blocks(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> np.ndarray:
     """``policy.act_batch`` on the rows ``obs`` of the episodes ``seeds``, called on blocks
     of :data:`POLICY_BLOCK` rows with seed ``s`` in row ``s % POLICY_BLOCK`` (zeros elsewhere)."""
-    blocks: dict[int, list[int]] = {}
-    for j, s in enumerate(seeds):
-        blocks.setdefault(s // POLICY_BLOCK, []).append(j)
+    seeds = np.asarray(seeds, dtype=np.int64)
+    block_of, row_of = np.divmod(seeds, POLICY_BLOCK)
     out: np.ndarray | None = None
-    for members in blocks.values():
-        rows = [seeds[j] % POLICY_BLOCK for j in members]
+    for b in np.unique(block_of):
+        members = np.flatnonzero(block_of == b)
+        rows = row_of[members]
         block = np.zeros((POLICY_BLOCK, *obs.shape[1:]), dtype=obs.dtype)
         block[rows] = obs[members]
         actions = np.asarray(policy.act_batch(block), dtype=np.float32)
         if out is None:
-            out = np.empty((len(seeds), *actions.shape[1:]), dtype=np.float32)
+            out = np.empty((seeds.size, *actions.shape[1:]), dtype=np.float32)
         out[members] = actions[rows]
     assert out is not None  # at least one seed
     return out
@@ -462,8 +473,8 @@ def _failing_seeds(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> tuple[
         try:
             _act_in_blocks(policy, obs[j : j + 1], [s])
         except Exception:
-            return (s,)
-    return tuple(seeds)
+            return (int(s),)
+    return tuple(int(s) for s in seeds)
 
 
 class _Actor:
@@ -472,6 +483,7 @@ class _Actor:
     def __init__(self, policy: Any, env: VectorEnv, seeds: Sequence[int]) -> None:
         self.policy = policy
         self.seeds = list(seeds)
+        self._seeds = np.asarray(self.seeds, dtype=np.int64)
         self.vector = hasattr(policy, "reset_vector")
         self.memoryless = not self.vector and hasattr(policy, "act_batch")
         self.env = env.unwrapped
@@ -498,7 +510,7 @@ class _Actor:
             return np.asarray(self.policy.act_vector(obs, info), dtype=np.float32)
         if self.memoryless:
             live = np.flatnonzero(alive)
-            seeds = [self.seeds[j] for j in live]
+            seeds = self._seeds[live]
             try:
                 acted = _act_in_blocks(self.policy, obs[live], seeds)
             except Exception as exc:

@@ -49,6 +49,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 from gymnasium.vector import VectorEnv
 
 from shipgym.benchmark.evaluate import (
@@ -61,7 +62,8 @@ from shipgym.benchmark.evaluate import (
 from shipgym.benchmark.policies import POLICIES, make_policy
 from shipgym.envs import CURRENT_ENV_IDS, ENV_IDS, env_task
 from shipgym.envs.wrappers import VectorActuatorDelay, VectorSensorNoise
-from shipgym.rl.train import BENCHMARK_SEED
+from shipgym.rl.agents import agent_files, load_meta
+from shipgym.rl.train import ALGOS, BENCHMARK_SEED
 
 CONTROLLERS = ("classic", "classic-tuned", "ppo", "sac", "zero")
 CONDITIONS = ("nominal", "stress", "mismatch", "noise", "delay")
@@ -259,10 +261,9 @@ class BenchmarkResult:
 def _cell(result: EvaluationResult, key: str) -> str:
     if result.blown_up:
         return f"blew up {result.blown_up}/{result.episodes}" if key == "return" else "-"
-    d = result.to_dict()
     if key == "return":
-        return f"{d['mean_return']:.1f} +- {d['std_return']:.1f}"
-    return f"{d['metrics'][key]:.3g} +- {d['metrics_std'][key]:.2g}"
+        return f"{result.mean_return:.1f} +- {float(np.std(result.returns)):.1f}"
+    return f"{result.metrics[key]:.3g} +- {result.metrics_std[key]:.2g}"
 
 
 def training_max_current(env_id: str) -> float:
@@ -628,14 +629,21 @@ def run_benchmark(
 
     start = time.perf_counter()
     agents: dict[str, dict[str, Any]] = {}
-    for env_id in envs:  # load (and check) every policy before the first episode
+    for env_id in envs:  # check every policy's record before the first episode
         for name in controllers:
-            policy = make_policy(name, env_id, agents_dir)
-            if hasattr(policy, "meta"):
-                check_seeds_disjoint(policy.meta, seed, episodes)
-                agents[policy.meta["name"]] = {
-                    k: policy.meta[k] for k in ("env", "algo", "timesteps", "seed", "wall_time_s")
+            if name in ALGOS:  # the agent's record and file (the workers load the network)
+                meta = load_meta(env_id, name, agents_dir)
+                weights, _ = agent_files(env_id, name, agents_dir)
+                if not weights.is_file():
+                    raise FileNotFoundError(
+                        f"{meta['name']}: the record is there but the agent {weights} is not"
+                    )
+                check_seeds_disjoint(meta, seed, episodes)
+                agents[meta["name"]] = {
+                    k: meta[k] for k in ("env", "algo", "timesteps", "seed", "wall_time_s")
                 }
+            else:
+                make_policy(name, env_id, agents_dir)
             if name == "classic-tuned":
                 from shipgym.benchmark.tuning import load_tuned
 

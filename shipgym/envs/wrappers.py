@@ -99,14 +99,60 @@ class _NoiseModel:
         self.std = np.array([self.levels[k] for k, _ in used])
 
     def measure(
-        self, states: np.ndarray, rows: Sequence[int] | np.ndarray, rngs: Sequence[Any]
+        self, states: np.ndarray, rows: Sequence[int] | np.ndarray, draws: _NoiseDraws
     ) -> np.ndarray:
-        """A copy of the true ``states`` ``(n, nx)`` with noise on ``rows``: row ``rows[k]``
-        draws one standard normal per noisy state from ``rngs[k]``."""
+        """A copy of the true ``states`` ``(n, nx)`` with noise on ``rows``: each of them takes
+        its next standard normal per noisy state from its stream of ``draws``."""
         measured = np.array(states, dtype=np.float64)
-        for i, rng in zip(rows, rngs, strict=True):
-            measured[i, self.index] += self.std * rng.standard_normal(self.index.size)
+        rows = np.asarray(rows, dtype=np.int64)
+        if rows.size:
+            measured[np.ix_(rows, self.index)] += self.std * draws.next(rows)
         return measured
+
+
+class _NoiseDraws:
+    """The sensor-noise generator of every row (:func:`noise_generator` of its episode's seed),
+    drawn :attr:`BLOCK` steps ahead.
+
+    A generator's standard normals come out in the same order however many are asked for at a
+    time, so a row's noise is the same as one draw of ``size`` numbers per step, at one
+    generator call per row every :attr:`BLOCK` steps.
+
+    Parameters
+    ----------
+    rows : int
+        Rows (sub-envs).
+    size : int
+        Numbers each row draws per step.
+    """
+
+    #: Steps drawn at a time.
+    BLOCK = 64
+
+    def __init__(self, rows: int, size: int) -> None:
+        self.size = size
+        self._rngs: list[np.random.Generator | None] = [None] * rows
+        self._ahead = np.zeros((rows, self.BLOCK, size))
+        self._used = np.full(rows, self.BLOCK, dtype=np.int64)
+
+    def start(self, rows: Sequence[int] | np.ndarray, seeds: Sequence[int]) -> None:
+        """Begin the episodes of ``rows``: row ``rows[k]`` draws from the generator of
+        ``seeds[k]``."""
+        for i, seed in zip(rows, seeds, strict=True):
+            self._rngs[i] = noise_generator(seed)
+            self._used[i] = self.BLOCK
+
+    def next(self, rows: np.ndarray) -> np.ndarray:
+        """The next ``size`` numbers of each of ``rows`` (distinct), shape ``(len(rows), size)``."""
+        for i in rows[self._used[rows] >= self.BLOCK]:
+            rng = self._rngs[i]
+            if rng is None:
+                raise RuntimeError(f"row {i} has no noise generator: reset it first")
+            self._ahead[i] = rng.standard_normal((self.BLOCK, self.size))
+            self._used[i] = 0
+        out = self._ahead[rows, self._used[rows]]
+        self._used[rows] += 1
+        return out
 
 
 def _holding_actions(task: Task, rows: Sequence[int] | np.ndarray) -> np.ndarray:
@@ -166,11 +212,11 @@ class SensorNoise(gym.Wrapper):
         super().__init__(env)
         self._noise = _NoiseModel(env.unwrapped.task.model.state_names, std)
         self.std = self._noise.levels
-        self._rng = np.random.default_rng()
+        self._draws = _NoiseDraws(1, self._noise.index.size)
 
     def _measure(self, obs: np.ndarray, info: dict[str, Any]) -> tuple[np.ndarray, dict]:
         task = self.env.unwrapped.task
-        measured = self._noise.measure(task.x, [0], [self._rng])
+        measured = self._noise.measure(task.x, [0], self._draws)
         noisy = task.observe(measured)[0].astype(obs.dtype)
         return noisy, {**info, "measured_state": measured[0]}
 
@@ -180,7 +226,7 @@ class SensorNoise(gym.Wrapper):
         obs, info = self.env.reset(seed=seed, options=options)
         if seed is None:
             seed = int(self.env.unwrapped.np_random.integers(_ENTROPY_HIGH))
-        self._rng = noise_generator(seed)
+        self._draws.start([0], [seed])
         return self._measure(obs, info)
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
@@ -224,7 +270,7 @@ class VectorSensorNoise(VectorWrapper):
             )
         self._noise = _NoiseModel(base.task.model.state_names, std)
         self.std = self._noise.levels
-        self._rngs: list[Any] = [None] * self.num_envs  # each row's, made at its reset
+        self._draws = _NoiseDraws(self.num_envs, self._noise.index.size)
         self._obs = np.zeros(self.observation_space.shape, dtype=self.observation_space.dtype)
 
     def _measure(
@@ -233,7 +279,7 @@ class VectorSensorNoise(VectorWrapper):
         """The noisy observations (``rows`` measured anew, the others as they were) and the
         info with the measured states of ``rows``."""
         task = self.env.unwrapped.task
-        measured = self._noise.measure(task.x, rows, [self._rngs[i] for i in rows])
+        measured = self._noise.measure(task.x, rows, self._draws)
         self._obs[rows] = task.observe(measured)[rows]
         flags = np.zeros(self.num_envs, dtype=np.bool_)
         flags[rows] = True
@@ -253,8 +299,7 @@ class VectorSensorNoise(VectorWrapper):
         drawn = self.env.unwrapped.draw_integers(unseeded, _ENTROPY_HIGH)
         for i, value in zip(unseeded, drawn, strict=True):
             seeds[i] = value
-        for i in rows:
-            self._rngs[i] = noise_generator(seeds[i])
+        self._draws.start(rows, [seeds[i] for i in rows])
         return self._measure(obs, info, rows)
 
     def step(
@@ -265,9 +310,7 @@ class VectorSensorNoise(VectorWrapper):
         obs, rewards, terminated, truncated, info = self.env.step(actions)
         if base.autoreset_mode is AutoresetMode.NEXT_STEP:  # the ended rows began anew
             restarted = np.flatnonzero(ended)
-            drawn = base.draw_integers(restarted, _ENTROPY_HIGH)
-            for i, value in zip(restarted, drawn, strict=True):
-                self._rngs[i] = noise_generator(value)
+            self._draws.start(restarted, base.draw_integers(restarted, _ENTROPY_HIGH))
             rows = np.arange(self.num_envs)
         else:  # disabled: the parked rows did not step
             rows = np.flatnonzero(~ended)

@@ -68,6 +68,8 @@ class AgentPolicy:
         norm = meta["obs_normaliser"]
         self.model = model
         self.meta = meta
+        # evaluation only: eval mode once, not at every call as ``predict`` switches it
+        model.policy.set_training_mode(False)
         self.mean = np.asarray(norm["mean"], dtype=np.float64)
         self.scale = 1.0 / np.sqrt(np.asarray(norm["var"], dtype=np.float64) + norm["epsilon"])
         self.clip = float(norm["clip"])
@@ -83,10 +85,48 @@ class AgentPolicy:
         z = (np.asarray(obs, dtype=np.float64) - self.mean) * self.scale
         return np.clip(z, -self.clip, self.clip).astype(np.float32)
 
+    def _deterministic(self, obs: Any) -> Any:
+        """The policy network's deterministic action tensor for an observation tensor.
+
+        The mean of the Gaussian head (PPO's ``action_net``; SAC's ``mu`` squashed by tanh),
+        the very tensors SB3's ``_predict`` returns through its action distribution, without
+        building the distribution (which took twice the network's time on 64 rows); another
+        policy runs SB3's ``_predict``.
+        """
+        import torch
+        from stable_baselines3.common.distributions import DiagGaussianDistribution
+
+        policy = self.model.policy
+        actor = getattr(policy, "actor", None)
+        if actor is not None and hasattr(actor, "mu") and not actor.use_sde:  # SAC
+            features = actor.extract_features(obs, actor.features_extractor)
+            return torch.tanh(actor.mu(actor.latent_pi(features)))
+        gaussian = isinstance(getattr(policy, "action_dist", None), DiagGaussianDistribution)
+        if hasattr(policy, "action_net") and gaussian:  # PPO, A2C
+            features = policy.extract_features(obs, policy.pi_features_extractor)
+            return policy.action_net(policy.mlp_extractor.forward_actor(features))
+        return policy._predict(obs, deterministic=True)
+
     def act_batch(self, obs: np.ndarray) -> np.ndarray:
-        """Deterministic actions for a batch of observations, shape ``(n, act_dim)``."""
-        action, _ = self.model.predict(self.normalise(obs), deterministic=True)
-        return np.asarray(action, dtype=np.float32)
+        """Deterministic actions for a batch of observations, shape ``(n, act_dim)``.
+
+        The arithmetic of SB3's ``policy.predict`` (the same network, clipping or
+        unsquashing; :meth:`_deterministic`), without its per-call switch to evaluation mode,
+        which walks every module of the network.
+        """
+        import torch
+
+        policy = self.model.policy
+        # (the float32 array as it is: what SB3's obs_to_tensor makes of a Box observation)
+        obs_tensor = torch.from_numpy(self.normalise(obs).reshape(-1, *self.mean.shape))
+        with torch.no_grad():
+            actions = self._deterministic(obs_tensor)
+        actions = actions.cpu().numpy().reshape((-1, *policy.action_space.shape))
+        if policy.squash_output:
+            actions = policy.unscale_action(actions)
+        else:
+            actions = np.clip(actions, policy.action_space.low, policy.action_space.high)
+        return np.asarray(actions, dtype=np.float32)
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         """Nothing to reset: the policy is memoryless."""
