@@ -393,8 +393,17 @@ def _cell_batch(
 
 def _evaluate_cell(*cell: Any) -> EvaluationResult:
     """One benchmark cell, evaluated here (the arguments of :func:`_cell_batch`: names and
-    numbers, so that a spawned worker process needs nothing else)."""
-    return _cell_batch(*cell).run()
+    numbers, so that a spawned worker process needs nothing else), with its bootstrap
+    intervals computed (in the worker, beside the other cells, rather than one after another
+    in the process that writes the tables)."""
+    result = _cell_batch(*cell).run()
+    _ = result.return_ci95, result.metrics_ci95
+    return result
+
+
+def _episode_steps(env_id: str) -> int:
+    """The registered episode length of ``env_id`` [steps]."""
+    return int(gym.spec(env_id).max_episode_steps or 0)
 
 
 def task_episodes(total: int, cpus: int) -> int:
@@ -678,11 +687,16 @@ def run_benchmark(
             report(_evaluate_cell(*cell), time.perf_counter() - t0)
     else:
         context = multiprocessing.get_context("spawn")  # no fork of torch's or numba's threads
-        with ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread) as pool:
+        pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread)
+        try:
             t0 = time.perf_counter()
-            futures = {pool.submit(_evaluate_cell, *cell): k for k, cell in enumerate(cells)}
+            # the longest episodes first, so that no worker waits on a long last cell
+            longest_first = sorted(cells, key=lambda c: -_episode_steps(c[0]))
+            futures = {pool.submit(_evaluate_cell, *cell): cell for cell in longest_first}
             for future in as_completed(futures):
                 report(future.result(), time.perf_counter() - t0)
+        finally:  # the workers wind down (torch's exit takes a second) while the tables are made
+            pool.shutdown(wait=False, cancel_futures=True)
         order = {(c[0], c[2], c[4]): k for k, c in enumerate(cells)}  # env, label, controller
         results.sort(key=lambda r: order[r.env, r.condition, r.controller])
     return BenchmarkResult(
