@@ -89,9 +89,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
-import control
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -115,6 +114,9 @@ from controllers._angles import (
     tracking_time,
     unwrap_towards,
 )
+
+if TYPE_CHECKING:  # python-control is imported where a design is checked: 1 s of import
+    import control
 
 __all__ = [
     "HeadingAutopilot",
@@ -350,6 +352,7 @@ class LoopMargins:
 def _phase_crossovers(loop: control.TransferFunction, tau: float) -> np.ndarray:
     """Every frequency [rad/s] where the phase of ``L(jw) e^{-jw tau}`` is -180 deg (mod
     360), on a grid spanning the loop's poles and zeros, refined by Brent's method."""
+    import control
     from scipy.optimize import brentq
 
     corners = np.abs(np.concatenate([control.poles(loop), control.zeros(loop)]))
@@ -410,6 +413,8 @@ def loop_margins(loop: control.TransferFunction, delay: float = 0.0) -> LoopMarg
         For a loop that is not a SISO transfer function or a delay that is not a finite
         number >= 0.
     """
+    import control
+
     if not isinstance(loop, control.TransferFunction) or loop.ninputs != 1 or loop.noutputs != 1:
         raise ValueError(f"loop must be a SISO control.TransferFunction, got {loop!r}")
     tau = nonnegative("delay", delay)
@@ -591,6 +596,8 @@ class HeadingReferenceModel:
 
     def transfer_function(self) -> control.TransferFunction:
         """``psi_d / psi_ref = w^3 / (s^3 + (2 zeta + 1) w s^2 + (2 zeta + 1) w^2 s + w^3)``."""
+        import control
+
         w, z = self.omega, self.zeta
         return control.tf([w**3], [1.0, (2 * z + 1) * w, (2 * z + 1) * w * w, w**3])
 
@@ -1010,6 +1017,8 @@ class HeadingAutopilot:
         ValueError
             Without a plant when the autopilot has no ``nomoto`` model.
         """
+        import control
+
         if actuator_time_constant is None:
             actuator_time_constant = self.actuator_time_constant
         ta = nonnegative("actuator_time_constant", actuator_time_constant)
