@@ -8,8 +8,9 @@ keep angles such as the reference heading *unwrapped* inside and wrap only diffe
 Batches: the autopilots keep their states as arrays of shape ``(n,)``, one entry per ship, and
 one ship is a batch of one (arrays of shape ``(1,)``) of the same code. :func:`batch_size`
 finds ``n`` from the arguments (``None``: numbers given, one ship in *scalar mode*),
-:func:`finite_batch` checks an argument, and :class:`BatchValue` reads a state back as a
-float in scalar mode and as an array for a batch.
+:func:`finite_batch` checks an argument (a number or a row such as a (north, east) position
+per ship; the one check of every controller's array arguments), and :class:`BatchValue` reads
+a state back as a float in scalar mode and as an array for a batch.
 """
 
 from __future__ import annotations
@@ -124,50 +125,65 @@ def batch_size(**values: Any) -> int | None:
     return n
 
 
-def finite_batch(name: str, value: Any, n: int | None, *, broadcast: bool = True) -> np.ndarray:
-    """``value`` as a finite float64 array for a batch of ``n`` ships, or ``ValueError``.
+def finite_batch(
+    name: str,
+    value: Any,
+    n: int | None,
+    *,
+    per_ship: tuple[int, ...] = (),
+    broadcast: bool = True,
+) -> np.ndarray:
+    """``value`` as a new finite float64 array for a batch of ``n`` ships, or ``ValueError``.
+
+    The one check of the controllers' array arguments. The result is always a copy: the
+    caller may change its array later.
 
     Parameters
     ----------
     name : str
         The argument's name for the error message.
     value : float or array_like
-        A number for one ship (``n`` ``None``: returned with shape ``(1,)``), an array of
-        shape ``(n,)`` for a batch, or a number for every ship of a batch (``broadcast``).
+        An array of shape ``(n, *per_ship)`` for a batch; for one ship in scalar mode (``n``
+        ``None``) an array of shape ``per_ship`` (a number when ``per_ship`` is ``()``),
+        returned with a leading axis of length 1; with ``broadcast``, a number for every
+        entry of a batch.
     n : int or None
         Ships in the batch; ``None`` for one ship in scalar mode.
+    per_ship : tuple of int
+        Shape of one ship's entry, e.g. ``(2,)`` for a (north, east) position.
     broadcast : bool
-        Accept a number for every ship of a batch.
+        Accept a number for every entry of a batch.
 
     Raises
     ------
     ValueError
-        For a value that is not a finite number (naming the index of the first bad entry of
-        an array) or that has the wrong shape (naming its shape and the expected one).
+        For a value that has the wrong shape (naming its shape and the expected one) or that
+        is not finite (naming the index and the value of the first bad entry).
     """
-    if n is None:
-        if not isinstance(value, float | int) and np.ndim(value) != 0:
-            raise ValueError(
-                f"{name} has shape {np.shape(value)}, expected a number (shape ()): the "
-                "controller runs one ship since its last reset (reset it with arrays for a batch)"
-            )
-        return np.array([finite(name, value)])
+    if isinstance(value, float | int) and not per_ship and (n is None or broadcast):
+        return np.full(1 if n is None else n, finite(name, value))
+    shape = per_ship if n is None else (n, *per_ship)
+    expected = f"{shape}" if shape else "a number"
     try:
         a = np.array(value, dtype=np.float64)  # a copy: the caller may change its array later
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be finite numbers, got {value!r}") from None
-    if a.shape != (n,):
-        if not (broadcast and a.ndim == 0):
-            kind = f"({n},) or a number" if broadcast else f"({n},)"
+        msg = f"{name} must be finite numbers, got {value!r}, expected {expected}"
+        raise ValueError(msg) from None
+    if a.shape != shape:
+        if n is None:
             raise ValueError(
-                f"{name} has shape {a.shape}, expected {kind}: one entry per ship of the batch"
+                f"{name} has shape {a.shape}, expected {expected}: the controller runs one ship"
             )
-        a = np.full(n, finite(name, a))
+        if not (broadcast and a.ndim == 0):
+            alternative = " or a number" if broadcast else ""
+            raise ValueError(f"{name} has shape {a.shape}, expected {expected}{alternative}")
+        a = np.full(shape, finite(name, a.item()))
     bad = ~np.isfinite(a)
     if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(f"{name}[{i}] must be a finite number, got {float(a[i])!r}")
-    return a
+        i = np.unravel_index(int(np.argmax(bad)), a.shape)
+        where = f"{name}[{', '.join(str(int(j)) for j in i)}]" if i else name
+        raise ValueError(f"{where} must be a finite number, got {float(a[i])!r}")
+    return a if n is not None else a[None]
 
 
 def batch_value(values: np.ndarray, n: int | None) -> float | np.ndarray:
@@ -229,17 +245,6 @@ def optional_limit(name: str, value: Any) -> float:
     if value is None:
         return math.inf
     return positive(name, value, allow_inf=True)
-
-
-def point(name: str, value: Any) -> np.ndarray:
-    """A finite ``(2,)`` (north, east) vector, or ``ValueError``."""
-    try:
-        v = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        v = np.array([np.nan])
-    if v.shape != (2,) or not (math.isfinite(v[0]) and math.isfinite(v[1])):
-        raise ValueError(f"{name} must be 2 finite (north, east) values, got {value!r}")
-    return v
 
 
 class StepClock:
@@ -361,29 +366,3 @@ def math_elementwise(func: Any, *args: np.ndarray) -> np.ndarray:
     flat = [np.ravel(a).tolist() for a in args]
     return np.fromiter(map(func, *flat), np.float64, count=len(flat[0])).reshape(shape)
 
-
-def batch_array(
-    name: str, value: Any, shape: tuple[int, ...], what: str, *, broadcast: bool = False
-) -> np.ndarray:
-    """``value`` as a finite float64 array of ``shape``, or ``ValueError`` naming ``name``.
-
-    ``broadcast``: ``shape`` is ``(n,)`` (one value per ship) and a single number is accepted
-    for every ship. ``what`` describes the expected values in the message, e.g.
-    ``"finite yaw rates [rad/s]"``.
-    """
-    if broadcast and isinstance(value, float | int) and math.isfinite(value):
-        return np.full(shape, float(value))
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {what} of shape {shape}; got {value!r}") from None
-    if a.shape != shape:
-        if not (broadcast and a.size == 1 and a.ndim <= 1):
-            raise ValueError(f"{name} must be {what} of shape {shape}; got shape {a.shape}")
-        a = np.full(shape, a.item())
-    ok = np.isfinite(a)
-    if not np.logical_and.reduce(ok, axis=None):
-        i = tuple(int(j) for j in np.unravel_index(int(np.argmin(ok)), shape))
-        where = i[0] if len(i) == 1 else i
-        raise ValueError(f"{name} must be {what}; got {float(a[i])!r} at index {where}")
-    return a

@@ -73,8 +73,8 @@ import numpy as np
 import numpy.typing as npt
 
 from controllers._angles import (
-    batch_array,
     constant,
+    finite_batch,
     math_elementwise,
     nonnegative,
     positive,
@@ -271,15 +271,10 @@ class _LOSBase:
         if self._t is not None and tt < self._t:
             raise ValueError(f"t must not decrease: got {tt!r} s after {self._t!r} s")
         dt = 0.0 if self._t is None else tt - self._t
-        n = self.n_ships
-        if self._batch:
-            p = batch_array("position", position, (n, 2), f"finite (north, east) [m] of {n} ships")
-            each = ", one per ship"
-        else:
-            p = batch_array("position", position, (2,), "a finite (north, east) pair [m]")[None]
-            each = ""
-        rr = batch_array("r", r, (n,), f"finite yaw rates [rad/s]{each}", broadcast=True)
-        batch_array("psi", psi, (n,), f"finite headings [rad]{each}", broadcast=True)
+        n = self.n_ships if self._batch else None
+        p = finite_batch("position", position, n, per_ship=(2,), broadcast=False)
+        rr = finite_batch("r", r, n)
+        finite_batch("psi", psi, n)
         self._t = tt
         if self._is_waypoint:
             self._locate_waypoints(p)

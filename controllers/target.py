@@ -43,8 +43,9 @@ import numpy.typing as npt
 
 from controllers._angles import (
     StepClock,
-    batch_array,
+    batch_size,
     constant,
+    finite_batch,
     math_elementwise,
     nonnegative,
     positive,
@@ -150,7 +151,7 @@ class ConstantBearingGuidance:
         previous target position."""
         self._clock.reset(t)
         n = self.n_ships
-        courses = batch_array("course", course, (n,), "finite courses [rad]", broadcast=True)
+        courses = finite_batch("course", course, n if self._batch else None)
         self._chi_d = ssa_array(courses)
         self._U_d = np.zeros(n)
         self._prev_target: np.ndarray | None = None
@@ -165,10 +166,8 @@ class ConstantBearingGuidance:
 
     def _points(self, name: str, value: npt.ArrayLike) -> np.ndarray:
         """``(n, 2)`` finite (north, east) values, checked against the batch size."""
-        if self._batch:
-            n = self.n_ships
-            return batch_array(name, value, (n, 2), f"finite (north, east) values of {n} ships")
-        return batch_array(name, value, (2,), "2 finite (north, east) values")[None]
+        n = self.n_ships if self._batch else None
+        return finite_batch(name, value, n, per_ship=(2,), broadcast=False)
 
     # ------------------------------------------------------------------- read-outs
     @property
@@ -288,7 +287,7 @@ class ConstantBearingGuidance:
                 vt = (pt - self._prev_target) / h
             else:
                 vt = np.zeros(pt.shape)
-        self._prev_target = pt.copy()
+        self._prev_target = pt  # a copy of the caller's array
         v_d, v_a, aim, rng = self._velocity(p, pt, vt)
         speed = math_elementwise(math.hypot, v_d[:, 0], v_d[:, 1])
         course = ssa_array(math_elementwise(math.atan2, v_d[:, 1], v_d[:, 0]))
@@ -301,21 +300,14 @@ class ConstantBearingGuidance:
 
 def _distances(distance: float | npt.ArrayLike) -> tuple[np.ndarray, bool]:
     """The distances [m] as an ``(n,)`` array and whether a batch (an array) was given."""
-    try:
-        d = np.asarray(distance, dtype=np.float64)
-    except (TypeError, ValueError):
-        d = np.array(np.nan)
-    if d.ndim == 0:
+    n = batch_size(distance=distance)
+    if n is None:
         return np.array([nonnegative("distance", distance)]), False
-    if d.ndim != 1 or d.size == 0:
-        raise ValueError(
-            f"distance must be a number >= 0 [m] or one per ship, shape (n,); got shape {d.shape}"
-        )
-    bad = np.flatnonzero(~(np.isfinite(d) & (d >= 0.0)))
-    if bad.size:
-        i = int(bad[0])
-        raise ValueError(
-            f"distance must be finite numbers >= 0 [m], one per ship; got {float(d[i])!r} at "
-            f"index {i}"
-        )
-    return d.copy(), True
+    if n == 0:
+        raise ValueError("distance must be a number >= 0 [m] or one per ship, got an empty array")
+    d = finite_batch("distance", distance, n)
+    negative = np.flatnonzero(d < 0.0)
+    if negative.size:
+        i = int(negative[0])
+        raise ValueError(f"distance[{i}] must be >= 0 [m], got {float(d[i])!r}")
+    return d, True

@@ -302,38 +302,44 @@ def test_errors_name_the_bad_value_and_the_expected_shape() -> None:
     with pytest.raises(ValueError, match=r"only WaypointPaths or only continuous.*FilletPath at 1"):
         IntegralLOS([north, FilletPath([[0, 0], [100, 0], [100, 100]], 10.0)], 100.0)
     los = LOSGuidance([north] * 4, 100.0)
-    with pytest.raises(
-        ValueError,
-        match=r"position must be finite .* of 4 ships of shape \(4, 2\); got shape \(4, 3\)",
-    ):
+    with pytest.raises(ValueError, match=r"^position has shape \(4, 3\), expected \(4, 2\)$"):
         los.update(0.0, np.zeros((4, 3)))
-    with pytest.raises(
-        ValueError,
-        match=r"r must be finite yaw rates \[rad/s\], one per ship of shape \(4,\); got shape \(3",
-    ):
+    with pytest.raises(ValueError, match=r"^r has shape \(3,\), expected \(4,\) or a number$"):
         los.update(0.0, np.zeros((4, 2)), 0.0, np.zeros(3))
-    with pytest.raises(ValueError, match=r"yaw rates .* got nan at index 2"):
+    with pytest.raises(ValueError, match=r"^r\[2\] must be a finite number, got nan$"):
         los.update(0.0, np.zeros((4, 2)), 0.0, [0.0, 0.0, np.nan, 0.0])
-    with pytest.raises(ValueError, match=r"psi must be .* of shape \(4,\); got shape \(2, 2\)"):
+    with pytest.raises(ValueError, match=r"^position\[1, 1\] must be a finite number, got inf$"):
+        los.update(0.0, [[0.0, 0.0], [0.0, np.inf], [0.0, 0.0], [0.0, 0.0]])
+    with pytest.raises(ValueError, match=r"^psi has shape \(2, 2\), expected \(4,\) or a number$"):
         los.update(0.0, np.zeros((4, 2)), np.zeros((2, 2)))
     with pytest.raises(
-        ValueError,
-        match=r"position must be a finite \(north, east\) pair .* shape \(2,\); got shape \(1, 2\)",
+        ValueError, match=r"^position has shape \(1, 2\), expected \(2,\): the controller runs one"
     ):
         LOSGuidance(north, 100.0).update(0.0, np.zeros((1, 2)))
-    with pytest.raises(ValueError, match=r"distance must be .* shape \(n,\); got shape \(2, 2\)"):
+    with pytest.raises(ValueError, match=r"distance must be a number or a 1-D array.*\(2, 2\)"):
         ConstantBearingGuidance(1.0, 100.0, np.zeros((2, 2)))
-    with pytest.raises(
-        ValueError, match=r"distance must be finite numbers >= 0.*got -5.0 at index 1"
-    ):
+    with pytest.raises(ValueError, match=r"^distance\[1\] must be >= 0 \[m\], got -5.0$"):
         ConstantBearingGuidance(1.0, 100.0, [10.0, -5.0])
+    with pytest.raises(ValueError, match=r"^distance\[0\] must be a finite number, got nan$"):
+        ConstantBearingGuidance(1.0, 100.0, [np.nan, 5.0])
     cb = ConstantBearingGuidance(1.0, 100.0, [10.0, 20.0, 30.0])
     with pytest.raises(
-        ValueError,
-        match=r"target_position must be .* of 3 ships of shape \(3, 2\); got shape \(2,\)",
+        ValueError, match=r"^target_position has shape \(2,\), expected \(3, 2\)$"
     ):
         cb.update(0.0, np.zeros((3, 2)), [0.0, 0.0])
-    with pytest.raises(
-        ValueError, match=r"course must be finite courses \[rad\] of shape \(3,\); got shape \(2,\)"
-    ):
+    with pytest.raises(ValueError, match=r"^course has shape \(2,\), expected \(3,\) or a number$"):
         cb.reset(course=[0.0, 1.0])
+
+
+def test_the_guidance_keeps_a_copy_of_the_target_position() -> None:
+    """Changing the caller's array after an update leaves the velocity estimate alone."""
+    cb = ConstantBearingGuidance(1.0, 100.0, [10.0, 20.0])
+    ships = np.zeros((2, 2))
+    target = np.array([[500.0, 0.0], [0.0, 500.0]])
+    cb.update(0.0, ships, target)
+    target += 3.0  # moved in place: 3 m in 1 s
+    cb.update(1.0, ships, target)
+    alone = ConstantBearingGuidance(1.0, 100.0, [10.0, 20.0])
+    alone.update(0.0, ships, target - 3.0)
+    alone.update(1.0, ships, target, np.full((2, 2), 3.0))
+    np.testing.assert_array_equal(cb.desired_velocity, alone.desired_velocity)

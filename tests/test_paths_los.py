@@ -399,7 +399,7 @@ def test_los_input_validation():
         los.update(4.0, (0.0, 0.0))
     with pytest.raises(ValueError, match="position"):
         los.update(6.0, (np.nan, 0.0))
-    with pytest.raises(ValueError, match="yaw rate"):
+    with pytest.raises(ValueError, match="r must be a finite number, got inf"):
         los.update(6.0, (0.0, 0.0), 0.0, np.inf)
     los.reset()
     assert los.update(0.0, (0.0, 0.0)) == 0.0 and not los.finished
