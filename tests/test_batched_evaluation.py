@@ -56,3 +56,31 @@ def test_every_benchmark_cell_gives_the_reference_numbers(env_id: str) -> None:
         for key, values in ref["per_episode"].items():
             _same(result.values(key).tolist(), values, f"{what} {key}")
         assert not any(math.isnan(r) for r in result.returns) or result.blown_up, what
+
+
+class _OneShip:
+    """Hides a classic policy's batch methods: :func:`evaluate` runs its episodes one by one
+    through ``reset``/``act``, a single env's view (a batch of one of the same controllers)."""
+
+    def __init__(self, policy: object) -> None:
+        self.policy = policy
+
+    def reset(self, env, obs, info) -> None:
+        self.policy.reset(env, obs, info)
+
+    def act(self, obs, info):
+        return self.policy.act(obs, info)
+
+
+@pytest.mark.parametrize("env_id", ["shipgym/RVGPathFollowing-v1", "shipgym/RVGTargetTracking-v1"])
+def test_a_classic_policy_one_ship_at_a_time_gives_the_batch_numbers(env_id: str) -> None:
+    from shipgym.benchmark import evaluate, make_policy
+
+    batch = evaluate(env_id, make_policy("classic", env_id), "classic", 3, BENCHMARK_SEED,
+                     progress=lambda line: None)  # fmt: skip
+    alone = evaluate(env_id, _OneShip(make_policy("classic", env_id)), "classic", 3,
+                     BENCHMARK_SEED, progress=lambda line: None)  # fmt: skip
+    assert alone.lengths == batch.lengths
+    assert alone.returns == batch.returns  # bitwise: the same controllers, one row at a time
+    for key in batch.per_episode[0]:
+        _same(alone.values(key).tolist(), batch.values(key).tolist(), key)
