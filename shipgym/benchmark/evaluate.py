@@ -449,20 +449,34 @@ def _row_info(info: dict[str, Any], k: int) -> dict[str, Any]:
     return out
 
 
-def _act_in_blocks(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> np.ndarray:
-    """``policy.act_batch`` on the rows ``obs`` of the episodes ``seeds``, called on blocks
-    of :data:`POLICY_BLOCK` rows with seed ``s`` in row ``s % POLICY_BLOCK`` (zeros elsewhere)."""
+def _blocks(seeds: Sequence[int]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The :data:`POLICY_BLOCK`-row blocks of the episodes ``seeds``: for each block, the
+    indices into ``seeds`` of its episodes and their rows in it (``s % POLICY_BLOCK``)."""
     seeds = np.asarray(seeds, dtype=np.int64)
     block_of, row_of = np.divmod(seeds, POLICY_BLOCK)
-    out: np.ndarray | None = None
+    layout = []
     for b in np.unique(block_of):
         members = np.flatnonzero(block_of == b)
-        rows = row_of[members]
+        layout.append((members, row_of[members]))
+    return layout
+
+
+def _act_in_blocks(
+    policy: Any,
+    obs: np.ndarray,
+    seeds: Sequence[int],
+    layout: list[tuple[np.ndarray, np.ndarray]] | None = None,
+) -> np.ndarray:
+    """``policy.act_batch`` on the rows ``obs`` of the episodes ``seeds``, called on blocks
+    of :data:`POLICY_BLOCK` rows with seed ``s`` in row ``s % POLICY_BLOCK`` (zeros elsewhere);
+    ``layout`` is :func:`_blocks` of ``seeds`` if known."""
+    out: np.ndarray | None = None
+    for members, rows in layout if layout is not None else _blocks(seeds):
         block = np.zeros((POLICY_BLOCK, *obs.shape[1:]), dtype=obs.dtype)
         block[rows] = obs[members]
         actions = np.asarray(policy.act_batch(block), dtype=np.float32)
         if out is None:
-            out = np.empty((seeds.size, *actions.shape[1:]), dtype=np.float32)
+            out = np.empty((len(seeds), *actions.shape[1:]), dtype=np.float32)
         out[members] = actions[rows]
     assert out is not None  # at least one seed
     return out
@@ -489,6 +503,9 @@ class _Actor:
         self.memoryless = not self.vector and hasattr(policy, "act_batch")
         self.env = env.unwrapped
         self.act_dim = int(env.single_action_space.shape[0])
+        #: the live rows and their blocks, made anew when an episode ends
+        self._live: np.ndarray | None = None
+        self._layout: list[tuple[np.ndarray, np.ndarray]] = []
         if not (self.vector or self.memoryless) and len(self.seeds) != 1:
             raise ValueError("a policy with act(obs, info) only runs one episode at a time")
 
@@ -510,10 +527,13 @@ class _Actor:
         if self.vector:
             return np.asarray(self.policy.act_vector(obs, info), dtype=np.float32)
         if self.memoryless:
-            live = np.flatnonzero(alive)
+            if self._live is None or self._live.size != np.count_nonzero(alive):
+                self._live = np.flatnonzero(alive)  # (episodes only end: a count tells a change)
+                self._layout = _blocks(self._seeds[self._live])
+            live = self._live
             seeds = self._seeds[live]
             try:
-                acted = _act_in_blocks(self.policy, obs[live], seeds)
+                acted = _act_in_blocks(self.policy, obs[live], seeds, self._layout)
             except Exception as exc:
                 exc.seeds = _failing_seeds(self.policy, obs[live], seeds)  # type: ignore[attr-defined]
                 raise
@@ -556,17 +576,18 @@ def _rollout(
             signals[key][:, t] = info[key]
         if targets is not None:
             targets[:, t] = task.target
-        ended = np.flatnonzero((terminated | truncated) & alive)
-        for k in ended:
+        done = (terminated | truncated) & alive
+        if not done.any():
+            continue
+        for k in np.flatnonzero(done):
             lengths[k] = t + 1
             reasons[k] = str(info["termination_reason"][k])
-        alive[ended] = False
+        alive &= ~done
         if not alive.any():
             break
-        if ended.size:  # the rows that ended feed the policy a finite state from now on
-            for key in ("state", "measured_state"):
-                if key in info:
-                    info[key][~alive] = x0[~alive]
+        for key in ("state", "measured_state"):  # the ended rows feed the policy a finite state
+            if key in info:
+                info[key][~alive] = x0[~alive]
     logs = []
     for k in range(n):
         length = int(lengths[k])
