@@ -58,9 +58,9 @@ def test_every_benchmark_cell_gives_the_reference_numbers(env_id: str) -> None:
         assert not any(math.isnan(r) for r in result.returns) or result.blown_up, what
 
 
-class _OneShip:
-    """Hides a classic policy's batch methods: :func:`evaluate` runs its episodes one by one
-    through ``reset``/``act``, a single env's view (a batch of one of the same controllers)."""
+class _OneAtATime:
+    """Hides a policy's batch methods: :func:`evaluate` runs its episodes one by one through
+    ``reset``/``act`` (for a classic policy: its controllers as a batch of one ship)."""
 
     def __init__(self, policy: object) -> None:
         self.policy = policy
@@ -78,9 +78,24 @@ def test_a_classic_policy_one_ship_at_a_time_gives_the_batch_numbers(env_id: str
 
     batch = evaluate(env_id, make_policy("classic", env_id), "classic", 3, BENCHMARK_SEED,
                      progress=lambda line: None)  # fmt: skip
-    alone = evaluate(env_id, _OneShip(make_policy("classic", env_id)), "classic", 3,
+    alone = evaluate(env_id, _OneAtATime(make_policy("classic", env_id)), "classic", 3,
                      BENCHMARK_SEED, progress=lambda line: None)  # fmt: skip
     assert alone.lengths == batch.lengths
     assert alone.returns == batch.returns  # bitwise: the same controllers, one row at a time
     for key in batch.per_episode[0]:
         _same(alone.values(key).tolist(), batch.values(key).tolist(), key)
+
+
+def test_an_agent_one_episode_at_a_time_gives_the_lockstep_numbers() -> None:
+    from shipgym.benchmark import evaluate
+    from shipgym.rl.agents import load_agent
+
+    env_id = "shipgym/RVGPathFollowing-v0"  # episodes of different lengths (early ends)
+    agent = load_agent(env_id, "ppo")
+    batched = evaluate(env_id, agent, "ppo", 3, BENCHMARK_SEED, progress=lambda line: None)
+    single = evaluate(env_id, _OneAtATime(agent), "ppo", 3, BENCHMARK_SEED,
+                      progress=lambda line: None)  # fmt: skip
+    assert [log.seed for log in batched.logs] == [BENCHMARK_SEED + k for k in range(3)]
+    assert [log.steps for log in batched.logs] == [log.steps for log in single.logs]
+    # a block of 64 rows against a block holding one row: matrix kernels may round differently
+    np.testing.assert_allclose(batched.returns, single.returns, rtol=1e-4)

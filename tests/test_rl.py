@@ -214,26 +214,3 @@ def test_shipped_agent_is_small_recorded_and_beats_zero(env_id: str, algo: str) 
     agent = evaluate(env_id, load_agent(env_id, algo), algo, 4, BENCHMARK_SEED, progress=_quiet)
     zero = evaluate(env_id, make_policy("zero", env_id), "zero", 4, BENCHMARK_SEED, progress=_quiet)
     assert np.mean(agent.returns) > np.mean(zero.returns) + 0.1 * abs(np.mean(zero.returns))
-
-
-class _OneAtATime:
-    """Hides ``act_batch`` so that :func:`evaluate` runs the episodes one by one."""
-
-    def __init__(self, policy: object) -> None:
-        self.policy = policy
-
-    def reset(self, env, obs, info) -> None:
-        self.policy.reset(env, obs, info)
-
-    def act(self, obs, info):
-        return self.policy.act(obs, info)
-
-
-def test_lockstep_evaluation_matches_one_episode_at_a_time() -> None:
-    env_id = "shipgym/RVGPathFollowing-v0"  # episodes of different lengths (early ends)
-    agent = load_agent(env_id, "ppo")
-    batched = evaluate(env_id, agent, "ppo", 3, BENCHMARK_SEED, progress=_quiet)
-    single = evaluate(env_id, _OneAtATime(agent), "ppo", 3, BENCHMARK_SEED, progress=_quiet)
-    assert [log.seed for log in batched.logs] == [BENCHMARK_SEED + k for k in range(3)]
-    assert [len(log.time) for log in batched.logs] == [len(log.time) for log in single.logs]
-    np.testing.assert_allclose(batched.returns, single.returns, rtol=1e-4)
