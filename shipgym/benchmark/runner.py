@@ -291,15 +291,6 @@ def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None
             )
 
 
-def _one_thread() -> None:
-    """Worker initializer: one torch thread per worker process (the workers share the cores)."""
-    try:
-        import torch
-    except ImportError:  # pragma: no cover - the rl extra is not installed
-        return
-    torch.set_num_threads(1)
-
-
 #: Ray tasks aimed at per CPU of the cluster when a campaign is split automatically (more
 #: than one, so that CPUs whose tasks end early take further ones).
 TASKS_PER_CPU = 4
@@ -687,7 +678,7 @@ def run_benchmark(
             report(_evaluate_cell(*cell), time.perf_counter() - t0)
     else:
         context = multiprocessing.get_context("spawn")  # no fork of torch's or numba's threads
-        pool = ProcessPoolExecutor(jobs, mp_context=context, initializer=_one_thread)
+        pool = ProcessPoolExecutor(jobs, mp_context=context)  # (evaluate: one torch thread)
         try:
             t0 = time.perf_counter()
             # the longest episodes first, so that no worker waits on a long last cell
