@@ -99,3 +99,29 @@ def test_an_agent_one_episode_at_a_time_gives_the_lockstep_numbers() -> None:
     assert [log.steps for log in batched.logs] == [log.steps for log in single.logs]
     # a block of 64 rows against a block holding one row: matrix kernels may round differently
     np.testing.assert_allclose(batched.returns, single.returns, rtol=1e-4)
+
+
+class _FailsOnRow:
+    """A memoryless policy whose network fails on the row of one seed (``s % 64``)."""
+
+    def __init__(self, seed: int) -> None:
+        self.row = seed % 64
+
+    def reset(self, env, obs, info) -> None:
+        self.act_dim = env.action_space.shape[-1]
+
+    def act_batch(self, obs: np.ndarray) -> np.ndarray:
+        if np.any(obs[self.row] != 0.0):
+            raise RuntimeError("bad row")
+        return np.zeros((len(obs), self.act_dim), dtype=np.float32)
+
+
+def test_a_failing_batched_policy_names_the_episode_it_failed_on() -> None:
+    from shipgym.benchmark import evaluate
+    from shipgym.benchmark.evaluate import EpisodeError
+
+    with pytest.raises(EpisodeError) as info:
+        evaluate("shipgym/RVGHeading-v1", _FailsOnRow(102), "custom", 5, 100,
+                 progress=lambda line: None)  # fmt: skip
+    assert info.value.seeds == (102,)
+    assert "episode with seed 102 failed: RuntimeError: bad row" in str(info.value)

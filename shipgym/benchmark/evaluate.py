@@ -492,6 +492,15 @@ def _failing_seeds(policy: Any, obs: np.ndarray, seeds: Sequence[int]) -> tuple[
     return tuple(int(s) for s in seeds)
 
 
+class _BlockFailed(Exception):
+    """A batched policy call failed; ``seeds`` are the episodes it is pinned on, the policy's
+    error is the ``__cause__``."""
+
+    def __init__(self, seeds: tuple[int, ...]) -> None:
+        super().__init__(seeds)
+        self.seeds = seeds
+
+
 class _Actor:
     """Calls a policy on a batch of episodes in the way it supports (see :func:`evaluate`)."""
 
@@ -535,8 +544,7 @@ class _Actor:
             try:
                 acted = _act_in_blocks(self.policy, obs[live], seeds, self._layout)
             except Exception as exc:
-                exc.seeds = _failing_seeds(self.policy, obs[live], seeds)  # type: ignore[attr-defined]
-                raise
+                raise _BlockFailed(_failing_seeds(self.policy, obs[live], seeds)) from exc
             actions = np.zeros((len(self.seeds), self.act_dim), dtype=np.float32)
             actions[live] = acted
             return actions
@@ -773,8 +781,9 @@ def _failing_episode(
     """The seed whose episode alone raises, and its error, after a batch of ``seeds`` raised
     ``exc``: each episode is run again alone until one raises (``exc`` and every seed if
     none does; the seeds ``act_batch`` named if a batched policy raised)."""
-    if hasattr(exc, "seeds"):
-        return exc.seeds, exc
+    if isinstance(exc, _BlockFailed):
+        cause = exc.__cause__
+        return exc.seeds, cause if isinstance(cause, Exception) else exc
     if len(seeds) > 1:
         for s in seeds:
             single = vector_env(env_id, 1, env_kwargs, wrappers)
