@@ -603,15 +603,17 @@ def _rollout(
         if hasattr(task, "waypoints"):
             extras["waypoints"] = task.waypoints(k)
         if targets is not None:
-            extras["target"] = targets[k, :length]
+            extras["target"] = targets[k, :length].copy()
         logs.append(
             EpisodeLog(
                 seed=int(seeds[k]),
                 time=np.arange(length) * base.task.dt + base.task.dt,
-                state=states[k, :length],
-                action=actions[k, :length],
-                reward=rewards[k, :length],
-                signals={key: signals[key][k, :length] for key in keys},
+                # copies: a log kept alone (the benchmark keeps one per cell) does not hold the
+                # whole batch's arrays
+                state=states[k, :length].copy(),
+                action=actions[k, :length].copy(),
+                reward=rewards[k, :length].copy(),
+                signals={key: signals[key][k, :length].copy() for key in keys},
                 termination_reason=reasons[k],
                 reset_info=reset_infos[k],
                 extras=extras,
