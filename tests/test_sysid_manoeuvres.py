@@ -194,7 +194,9 @@ def test_instant_model_has_no_overshoot_and_the_table_reports_it(synth, tmp_path
         for err in row["errors"]["lagged"].values():
             assert abs(err) < 0.5  # % or deg or absolute ratio
     md = mv.render_markdown(rows)
-    assert md.count("\n") == 2 + sum(len(mv._SHOWN[r["kind"]]) for r in rows)
+    # one line per quantity: straight U; turn r, U, diameter, U/U_approach; zigzag mean, max
+    per_kind = {"straight": 1, "turn": 4, "zigzag": 2}
+    assert md.count("\n") == 2 + sum(per_kind[r["kind"]] for r in rows)
     assert "| instant | instant error | lagged | lagged error |" in md
     assert "r [deg/s]" in md and "mean overshoot [deg]" in md
     png = mv.plot_validation(rows, tmp_path / "validation.png")
