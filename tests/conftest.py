@@ -7,7 +7,8 @@ test leaves there outside pytest's own ``tmp_path`` folders (an ``SB3-<date>`` l
 temporary file not cleaned up) fails the run with the names of what was left; the folder is
 removed either way, so a test run leaves nothing in the system's temporary directory. Torch runs
 on one thread (tiny networks). A cold kernel cache is filled before the tests start
-(:func:`shipgym.warmup.warm_cache`).
+(:func:`shipgym.warmup.warm_cache`). The measured records are read in place from the local
+mirror beside the checkout (``../shared/data/measured``) when ``SHIPGYM_MEASURED_DATA`` is unset.
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ _PYTEST_DIR = "pytest"
 #: torch makes its compiler cache folder ``torchinductor_<user>`` in the temporary directory
 #: when an optimiser is built; that is torch's cache, not a file a run forgot
 _THIRD_PARTY_CACHES = ("torchinductor_",)
+#: the project's local mirror of the measured datasets, beside the checkout (as in CI): the
+#: tests read the records there in place unless ``SHIPGYM_MEASURED_DATA`` names another copy
+_MEASURED_MIRROR = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
 
 
 def _is_worker(config: pytest.Config) -> bool:
@@ -36,6 +40,10 @@ def _root() -> Path:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    from shipgym.datasets import MEASURED_DATA_ENV
+
+    if not os.environ.get(MEASURED_DATA_ENV) and _MEASURED_MIRROR.is_dir():
+        os.environ[MEASURED_DATA_ENV] = str(_MEASURED_MIRROR)
     if not _is_worker(config):  # the workers get their tmp_path base from xdist, inside it
         root = Path(tempfile.mkdtemp(prefix="shipgym-tests-"))
         os.environ[_ROOT_VARIABLE] = str(root)

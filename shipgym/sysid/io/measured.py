@@ -1,31 +1,20 @@
 """The project's measured records: where they are and all of them at once (:func:`load_all`).
 
-The six measured sources are described in ``../shared/data/measured/SOURCES.md``; each has a
-loader module in :mod:`shipgym.sysid.io`.
+The six measured sources are the datasets of :mod:`shipgym.datasets` (their origins, licences
+and citations; ``shipgym data list``); each has a loader module in :mod:`shipgym.sysid.io`.
+:func:`measured_root` is the registry's: ``$SHIPGYM_MEASURED_DATA`` when set, else the user
+cache that ``shipgym data fetch`` fills.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
+from shipgym.datasets import MEASURED_DATA_ENV, measured_root
 from shipgym.sysid.io.registry import load
 from shipgym.sysid.record import Record
 
 __all__ = ["MEASURED_DATA_ENV", "load_all", "measured_root"]
-
-MEASURED_DATA_ENV = "SHIPGYM_MEASURED_DATA"
-"""Environment variable naming the ``measured`` folder (a copy of ``../shared/data/measured``)."""
-
-
-def measured_root() -> Path:
-    """The measured-data folder: ``$SHIPGYM_MEASURED_DATA`` when set, else
-    ``../shared/data/measured`` beside the checkout (where the project's sources keep it)."""
-    env = os.environ.get(MEASURED_DATA_ENV)
-    if env:
-        return Path(env).expanduser()
-    return Path(__file__).resolve().parents[4] / "shared" / "data" / "measured"
-
 
 _SOURCE_GLOBS: tuple[tuple[str, str], ...] = (
     ("sspa_blog_zigzag/*.csv", "sspa"),
@@ -40,7 +29,7 @@ _SOURCE_GLOBS: tuple[tuple[str, str], ...] = (
 def load_all(root: str | Path) -> list[Record]:
     """Load every file of the six measured sources under ``root`` (sorted by source, name).
 
-    ``root`` is the ``measured`` folder (``../shared/data/measured`` from the repo root).
+    ``root`` is the ``measured`` folder (:func:`measured_root`), one folder per source.
 
     Raises
     ------
