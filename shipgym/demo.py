@@ -4,10 +4,11 @@ Two short jobs that show the package end to end on built-in defaults:
 
 1. **Zigzag 20/20** of a Nomoto-family model (default ``nomoto1``, the Mariner class cargo ship
    of :mod:`shipgym.models.nomoto`) by :func:`shipgym.maneuvers.zigzag` (seed 000 logic).
-2. **Path following** in ``shipgym/RVGPathFollowing-v0`` (R/V Gunnerus) along a fixed path in
-   current, steered by the classic controller of ``shipgym evaluate``
-   (:class:`shipgym.benchmark.policies.RVGPathClassic`: lookahead LOS with the conditional
-   integrator commanding the heading autopilot, and a speed autopilot on the pod thrust).
+2. **Path following** in ``shipgym/RVGPathFollowing-v1`` (R/V Gunnerus) along a fixed path in
+   current, steered by the tuned classic controller of ``shipgym evaluate --controller
+   classic-tuned`` (:func:`shipgym.benchmark.policies.make_policy`: lookahead LOS with the
+   conditional integrator commanding the heading autopilot, and a speed autopilot on the pod
+   thrust).
 
 Each job writes a PNG; :func:`run_demo` runs both and returns the summary numbers.
 Matplotlib is used through :class:`~matplotlib.figure.Figure` objects rendered by the Agg
@@ -29,7 +30,7 @@ from matplotlib.patches import Polygon
 
 import shipgym  # noqa: F401  (registers the environments)
 from shipgym._io import write_atomically
-from shipgym.benchmark.policies import RVGPathClassic
+from shipgym.benchmark.policies import make_policy
 from shipgym.maneuvers import plot_zigzag, zigzag
 from shipgym.models import NOMOTO_MODEL_NAMES
 from shipgym.models.rvg import LPP, SERVICE_SPEED
@@ -43,7 +44,7 @@ __all__ = [
     "run_demo",
 ]
 
-PATH_ENV_ID = "shipgym/RVGPathFollowing-v0"
+PATH_ENV_ID = "shipgym/RVGPathFollowing-v1"
 #: The demo path: (north, east) waypoints [m], five legs of 400-500 m with 39-51 deg turns.
 DEMO_WAYPOINTS: tuple[tuple[float, float], ...] = (
     (0.0, 0.0),
@@ -122,13 +123,14 @@ def path_following_episode(
     seed: int = DEMO_SEED,
     current: tuple[float, float] = DEMO_CURRENT,
 ) -> PathEpisode:
-    """Run one ``shipgym/RVGPathFollowing-v0`` episode with ``policy``.
+    """Run one ``shipgym/RVGPathFollowing-v1`` episode with ``policy``.
 
     Parameters
     ----------
     policy : object, optional
         A policy of :mod:`shipgym.benchmark.policies` (``reset(env, obs, info)``,
-        ``act(obs, info)``); the classic LOS + heading and speed autopilots by default.
+        ``act(obs, info)``); by default the classic LOS + heading and speed autopilots with
+        the gains tuned on the env's ship (``shipgym evaluate --controller classic-tuned``).
     waypoints : array_like
         ``(m, 2)`` (north, east) waypoints [m], passed as the ``waypoints`` reset option.
     seed : int
@@ -140,7 +142,7 @@ def path_following_episode(
     -------
     PathEpisode
     """
-    policy = RVGPathClassic() if policy is None else policy
+    policy = make_policy("classic-tuned", PATH_ENV_ID) if policy is None else policy
     env = gym.make(PATH_ENV_ID)
     try:
         options = {
@@ -367,7 +369,7 @@ def format_summary(summary: dict[str, Any]) -> str:
             f"zigzag 20/20 ({summary['model']}): first overshoot "
             f"{summary['first_overshoot_deg']:.1f} deg, second overshoot "
             f"{summary['second_overshoot_deg']:.1f} deg",
-            f"path following (RVGPathFollowing-v0): completed "
+            f"path following ({PATH_ENV_ID.removeprefix('shipgym/')}): completed "
             f"{'yes' if summary['completed'] else 'no'} in {summary['episode_time_s']:.0f} s, "
             f"mean |cross-track| {summary['mean_abs_cross_track_m']:.1f} m "
             f"(max {summary['max_abs_cross_track_m']:.1f} m)",

@@ -186,11 +186,20 @@ def test_identify_bad_input_exit_2_and_no_output(
 def test_identify_checks_the_output_directory_before_the_run(
     records: dict[str, Path], tmp_path: Path
 ) -> None:
-    target = tmp_path / "missing" / "out.json"
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    target = blocker / "runs" / "out.json"
     code, _, stderr = _run(["identify", str(records["offset"]), "--json", str(target)])
     assert code == 2
-    assert "--json" in stderr and "does not exist" in stderr
+    assert "--json" in stderr and "is a file" in stderr
     assert not PROGRESS.search(stderr)  # refused before loading
+
+
+def test_identify_makes_missing_output_folders(records: dict[str, Path], tmp_path: Path) -> None:
+    target = tmp_path / "runs" / "fits" / "out.json"
+    code, _, _ = _run(["identify", str(records["offset"]), "--json", str(target), "--quiet"])
+    assert code == 0
+    assert json.loads(target.read_text())["model"]
 
 
 def test_identify_rvg3dof(tmp_path: Path) -> None:

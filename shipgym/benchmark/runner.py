@@ -287,7 +287,7 @@ def check_seeds_disjoint(meta: dict[str, Any], seed: int, episodes: int) -> None
             raise ValueError(
                 f"evaluation seeds {seed}..{seed + episodes - 1} overlap the {key.split('_')[0]} "
                 f"seeds {lo}..{hi} of {meta['name']}; choose a first seed outside them "
-                f"(the default {BENCHMARK_SEED} is)"
+                f"(--seed {BENCHMARK_SEED}, the benchmark's and evaluate's default, is)"
             )
 
 

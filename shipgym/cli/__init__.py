@@ -38,8 +38,20 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
-from shipgym.cli import bench, benchmark, demo, design, envs, evaluate, identify, simulate, train
+from shipgym.cli import (
+    bench,
+    benchmark,
+    data,
+    demo,
+    design,
+    envs,
+    evaluate,
+    identify,
+    simulate,
+    train,
+)
 from shipgym.cli._common import PROG, Builder
 
 __all__ = ["SUBCOMMANDS", "build_parser", "main"]
@@ -56,14 +68,25 @@ SUBCOMMANDS: dict[str, Builder] = {
     "benchmark": benchmark.build,
     "identify": identify.build,
     "design": design.build,
+    "data": data.build,
 }
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and a hint, not the whole usage."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``<prog>: error: <message>`` and where the options are listed; exit 2."""
+        self.exit(
+            2, f"{self.prog}: error: {message}\n  hint: '{self.prog} --help' lists the options\n"
+        )
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``shipgym`` argument parser with every subcommand of ``SUBCOMMANDS``."""
     from shipgym import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog=PROG,
         description=(
             "shipgym: ship manoeuvring environments, vessel models, classic control and "
@@ -71,7 +94,9 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    sub = parser.add_subparsers(
+        dest="command", metavar="COMMAND", required=True, help="the command to run"
+    )
     for build in SUBCOMMANDS.values():
         build(sub)
     return parser

@@ -17,18 +17,30 @@ Builder = Callable[["argparse._SubParsersAction[argparse.ArgumentParser]"], None
 
 def int_in(lo: int, hi: int) -> Callable[[str], int]:
     """An argparse type: an integer in ``[lo, hi]`` (a bound on every count and seed, so that
-    no flag can ask for an unbounded allocation)."""
+    no flag can ask for an unbounded allocation). Written as a user writes counts: ``100000``,
+    ``100_000`` or ``1e5`` (a number in exponent form that is a whole number)."""
 
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = None
+        value = parse_count(text)
         if value is None or not lo <= value <= hi:
             raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi:,}], got {text!r}")
         return value
 
     return parse
+
+
+def parse_count(text: str) -> int | None:
+    """``text`` as a whole number (``"100000"``, ``"100_000"``, ``"1e5"``, ``"2.5e3"``), or None
+    when it is not one (``"1.5"``, ``"ten"``, ``"nan"``)."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        return None
+    return int(value) if math.isfinite(value) and value.is_integer() else None
 
 
 def float_in(lo: float, hi: float, unit: str) -> Callable[[str], float]:
@@ -50,12 +62,11 @@ def float_in(lo: float, hi: float, unit: str) -> Callable[[str], float]:
 
 #: Largest seed (numpy's and Gymnasium's seeds are 32-bit here) and episode count of a run.
 MAX_SEED = 2**32 - 1
-
-
 MAX_EPISODES = 1_000_000
 
 
 def finite_float(text: str) -> float:
+    """An argparse type: any finite number."""
     try:
         value = float(text)
     except ValueError:
@@ -66,6 +77,7 @@ def finite_float(text: str) -> float:
 
 
 def progress_line(msg: str) -> None:
+    """Print one progress line of a long run to stderr, indented under the command's header."""
     print(f"  {msg}", file=sys.stderr, flush=True)
 
 
@@ -85,8 +97,8 @@ def probe_directory(directory: Path, flag: str, target: str) -> None:
 def output_path(text: str | None, flag: str, suffix: str | None = None) -> Path | None:
     """Check an output file before the (possibly long) run; ``-`` and None pass.
 
-    The file's directory must exist and take a new file (tried with a temporary file); an
-    existing output must be a regular file, which is replaced.
+    Missing parent folders are made (as ``mkdir -p`` would); the folder must take a new file
+    (tried with a temporary file); an existing output must be a regular file, which is replaced.
     """
     if text is None or text == "-":
         return None
@@ -97,22 +109,36 @@ def output_path(text: str | None, flag: str, suffix: str | None = None) -> Path 
         raise ValueError(f"{flag} names a directory, expected a file: {text!r}")
     if path.exists() and not path.is_file():
         raise ValueError(f"{flag}: {text!r} exists and is not a regular file")
-    if not path.parent.is_dir():
-        raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
-    probe_directory(path.parent, flag, text)
+    _make_folder(path.parent, flag, text)
     return path
 
 
 def output_dir(text: str, flag: str) -> Path:
-    """Check an output directory before the run: an existing one that takes files, or a new
-    one in an existing directory (created when the outputs are written, never its parents)."""
+    """Check an output folder before the run: an existing one that takes files, or a new one,
+    made with its missing parents (as ``mkdir -p`` would)."""
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise ValueError(f"{flag} names a file, expected a directory: {text!r}")
-    if not path.exists() and not path.parent.is_dir():
-        raise ValueError(f"{flag}: the directory {str(path.parent)!r} of {text!r} does not exist")
-    probe_directory(path if path.exists() else path.parent, flag, text)
+    _make_folder(path, flag, text)
     return path
+
+
+def _make_folder(folder: Path, flag: str, target: str) -> None:
+    """Make ``folder`` and its missing parents, then check that it takes a new file."""
+    for parent in (folder, *folder.parents):
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(
+                    f"{flag}: {str(parent)!r} is a file, so the folder of {target!r} cannot be made"
+                )
+            break
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(
+            f"{flag}: cannot make the folder {str(folder)!r}: {exc.strerror or exc}"
+        ) from None
+    probe_directory(folder, flag, target)
 
 
 def model_name(text: str) -> str:

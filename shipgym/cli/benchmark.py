@@ -164,7 +164,7 @@ def build(sub: Any) -> None:
             "condition and under stress (1.5 x the training current), model mismatch, sensor "
             "noise and an actuator delay. Prints a table of mean +- std of each metric, "
             "writes JSON (a list of 'shipgym evaluate' objects with per-episode values and "
-            "bootstrap 95 %% intervals) and CSV, figures of metrics, robustness and "
+            "bootstrap 95 % intervals) and CSV, figures of metrics, robustness and "
             "trajectories; with --throughput also PPO's training throughput on each env "
             "against CartPole-v1."
         ),
@@ -181,12 +181,32 @@ def build(sub: Any) -> None:
         type=int_in(0, MAX_SEED),
         default=BENCHMARK_SEED,
         metavar="S",
-        help="first seed (%(default)s)",
+        help="first seed of every cell; episode k has seed S + k (default: %(default)s)",
     )
-    p.add_argument("--out", default="shipgym-benchmark", metavar="DIR", help="%(default)s")
-    p.add_argument("--json", default=None, metavar="OUT", help="default: DIR/benchmark.json")
-    p.add_argument("--csv", default=None, metavar="OUT", help="default: DIR/benchmark.csv")
-    p.add_argument("--plots", default=None, metavar="DIR", help="figures (default: --out)")
+    p.add_argument(
+        "--out",
+        default="shipgym-benchmark",
+        metavar="DIR",
+        help="folder of the JSON, CSV and figures, made if missing (default: %(default)s)",
+    )
+    p.add_argument(
+        "--json",
+        default=None,
+        metavar="OUT",
+        help="the results as JSON (default: DIR/benchmark.json)",
+    )
+    p.add_argument(
+        "--csv",
+        default=None,
+        metavar="OUT",
+        help="one row per cell as CSV (default: DIR/benchmark.csv)",
+    )
+    p.add_argument(
+        "--plots",
+        default=None,
+        metavar="DIR",
+        help="folder of the figures (default: the --out folder)",
+    )
     p.add_argument(
         "--env",
         action="append",
@@ -245,5 +265,7 @@ def build(sub: Any) -> None:
         help="evaluations at once, one process each (default: one per core)",
     )
     add_ray_flags(p, "evaluations' episodes")
-    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument(
+        "--quiet", action="store_true", help="no progress lines (the table is still printed)"
+    )
     p.set_defaults(handler=run)

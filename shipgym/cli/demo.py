@@ -28,7 +28,7 @@ def build(sub: Any) -> None:
         help="zigzag trial and path-following episode, written as PNG figures",
         description=(
             "Simulate a 20/20 zigzag of a Nomoto-family ship (the Mariner class cargo ship) "
-            "and a path-following episode of R/V Gunnerus in shipgym/RVGPathFollowing-v0 "
+            "and a path-following episode of R/V Gunnerus in shipgym/RVGPathFollowing-v1 "
             "with a lookahead-LOS guidance and PD heading policy. Writes zigzag.png and "
             "path_following.png and prints the overshoots and the cross-track error."
         ),

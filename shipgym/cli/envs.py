@@ -7,17 +7,28 @@ from typing import Any
 
 
 def run(args: argparse.Namespace) -> int:
+    import warnings
+
     import gymnasium as gym
 
-    from shipgym.envs import ENV_IDS
+    from shipgym.envs import ENV_IDS, env_task
 
     tasks = _env_tasks()
     rows = []
     for env_id in ENV_IDS:
-        env = gym.make(env_id)
+        with warnings.catch_warnings():
+            # the table lists the older versions on purpose: no "out of date" warning for them
+            warnings.filterwarnings(
+                "ignore", message=".*is out of date", category=DeprecationWarning
+            )
+            env = gym.make(env_id)
         try:
             steps = env.spec.max_episode_steps if env.spec else None
             dt = float(env.unwrapped.dt)
+            task = tasks[env_task(env_id)]
+            if env_id.startswith("shipgym/RVG"):
+                params = env.spec.kwargs.get("params") if env.spec else None
+                task += f"; ship: {_GUNNERUS[params or 'seed001']}"
             rows.append(
                 (
                     env_id,
@@ -25,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
                     str(env.observation_space.shape[0]),
                     f"{dt:g}",
                     "-" if steps is None else f"{steps} ({steps * dt:g} s)",
-                    tasks.get(env_id, ""),
+                    task,
                 )
             )
         finally:
@@ -38,15 +49,22 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: The Gunnerus of each parameter set, as the table names it.
+_GUNNERUS = {
+    "seed001": "Gunnerus, seed 001's parameters",
+    "sea_trials": "Gunnerus identified from its sea trials",
+}
+
+
 def _env_tasks() -> dict[str, str]:
-    """Task and action of each id, from the table in :mod:`shipgym.envs`' docstring."""
+    """Task and action of each task name, from the table in :mod:`shipgym.envs`' docstring."""
     import shipgym.envs
 
     tasks = {}
     for line in (shipgym.envs.__doc__ or "").splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
         if len(cells) == 3 and cells[0].startswith("``shipgym/"):
-            tasks[cells[0].strip("`")] = f"{cells[1]}; action: {cells[2]}"
+            tasks[shipgym.envs.env_task(cells[0].strip("`"))] = f"{cells[1]}; action: {cells[2]}"
     return tasks
 
 

@@ -123,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
 def build(sub: Any) -> None:
     from shipgym.benchmark.policies import POLICIES
     from shipgym.envs import ENV_IDS
+    from shipgym.rl.train import BENCHMARK_SEED
 
     p = sub.add_parser(
         "evaluate",
@@ -134,11 +135,31 @@ def build(sub: Any) -> None:
             "the task metrics."
         ),
     )
-    p.add_argument("--env", required=True, choices=ENV_IDS, help="environment id")
-    p.add_argument("--controller", default="classic", choices=POLICIES, help="%(default)s")
-    p.add_argument("--episodes", type=int_in(1, MAX_EPISODES), default=10, metavar="N")
     p.add_argument(
-        "--seed", type=int_in(0, MAX_SEED), default=0, metavar="S", help="first seed (%(default)s)"
+        "--env", required=True, choices=ENV_IDS, help="the environment id (shipgym envs lists them)"
+    )
+    p.add_argument(
+        "--controller",
+        default="classic",
+        choices=POLICIES,
+        help="the policy: the classic controller (design-rule or tuned gains), a shipped agent "
+        "or the zero command (default: %(default)s)",
+    )
+    p.add_argument(
+        "--episodes",
+        type=int_in(1, MAX_EPISODES),
+        default=10,
+        metavar="N",
+        help="episodes, seeds S, S+1, ... (default: %(default)s)",
+    )
+    p.add_argument(
+        "--seed",
+        type=int_in(0, MAX_SEED),
+        default=BENCHMARK_SEED,
+        metavar="S",
+        help="first seed; the default is the benchmark's, outside every agent's training and "
+        "validation seeds and the tuned gains' seeds, so a cell of the benchmark is reproduced "
+        "(default: %(default)s)",
     )
     p.add_argument(
         "--agents",

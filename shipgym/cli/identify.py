@@ -274,7 +274,7 @@ def _load_for_identify(
     if not path.exists():
         raise ValueError(
             f"record file {path_text!r} does not exist (expected a measured-data file in one of "
-            f"the formats {', '.join(FORMATS)})"
+            f"the formats {', '.join(FORMATS)}, or a dataset name: shipgym data list)"
         )
     if not path.is_file():
         raise ValueError(f"{path_text!r} is not a file (expected a measured-data record file)")
@@ -315,6 +315,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
+    from shipgym.datasets import expand_records
     from shipgym.models.vmm import VMMParams, parse_particulars
     from shipgym.sysid import identify
     from shipgym.sysid.fit import SysidWarning
@@ -331,6 +332,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"[{time.perf_counter() - t0:6.1f} s] {msg}", file=sys.stderr, flush=True)
 
     say = (lambda _msg: None) if args.quiet else progress
+    args.path = expand_records(args.path)  # dataset names -> their files
     given = None if args.particulars is None else parse_particulars(args.particulars)
     records, sources = [], []
     for path_text in args.path:
@@ -446,8 +448,9 @@ def build(sub: Any) -> None:
         "path",
         metavar="PATH",
         nargs="+",
-        help="record file; several runs of one ship for the 3-DOF models vmm:<term set> "
-        "(fitted on some runs, scored on the others)",
+        help="record file, or a dataset name (all its runs) or NAME/PATTERN (shipgym data list; "
+        "e.g. marin-kvlcc2/MARIN_*zz*); several runs of one ship for the 3-DOF models "
+        "vmm:<term set> (fitted on some runs, scored on the others)",
     )
     p.add_argument(
         "--format",
@@ -494,7 +497,11 @@ def build(sub: Any) -> None:
         "5 median steps)",
     )
     p.add_argument(
-        "--model", default="nomoto1", choices=tuple(FAMILIES), help="base model (%(default)s)"
+        "--model",
+        default="nomoto1",
+        choices=tuple(FAMILIES),
+        help="the model family to fit: its base model, to which the loop adds effects "
+        "(default: %(default)s)",
     )
     p.add_argument(
         "--json",

@@ -167,7 +167,7 @@ def run(args: argparse.Namespace) -> int:
     plot_path = output_path(args.plot, "--plot", ".png")
     from shipgym.models import make_model
     from shipgym.models.model_file import is_model_file
-    from shipgym.models.rvg import RVG_PARAMETER_SETS
+    from shipgym.models.rvg import NEWEST_RVG_PARAMETERS, RVG_PARAMETER_SETS
 
     model_file = is_model_file(args.model)
     if model_file:
@@ -187,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(
                 f"--params for rvg3dof must be one of {RVG_PARAMETER_SETS}, got {args.params!r}"
             )
+        args.params = args.params or NEWEST_RVG_PARAMETERS
         args.ship = make_model("rvg3dof", args.params)
     elif args.params is not None:
         raise ValueError(
@@ -229,7 +230,7 @@ def run(args: argparse.Namespace) -> int:
 
 def build(sub: Any) -> None:
     from shipgym.models import MODEL_NAMES
-    from shipgym.models.rvg import RVG_PARAMETER_SETS
+    from shipgym.models.rvg import NEWEST_RVG_PARAMETERS, RVG_PARAMETER_SETS
 
     p = sub.add_parser(
         "simulate",
@@ -244,7 +245,11 @@ def build(sub: Any) -> None:
             "flipped (positive = starboard turn)."
         ),
     )
-    p.add_argument("manoeuvre", choices=tuple(_SIMULATE), help="trial to run")
+    p.add_argument(
+        "manoeuvre",
+        choices=tuple(_SIMULATE),
+        help="the trial: zigzag, turning circle, pull-out, spiral or the IMO table",
+    )
     p.add_argument(
         "--model",
         default="nomoto1",
@@ -257,8 +262,10 @@ def build(sub: Any) -> None:
         "--params",
         default=None,
         metavar="SET|FIT.json",
-        help=f"rvg3dof parameter set ({' or '.join(RVG_PARAMETER_SETS)}; default seed001); for "
-        "vmm the model file of a fit (shipgym identify --model vmm:<term set> --json FIT.json)",
+        help=f"rvg3dof parameter set ({' or '.join(RVG_PARAMETER_SETS)}; default "
+        f"{NEWEST_RVG_PARAMETERS}, the Gunnerus identified from its sea trials; seed001 is the "
+        "unvalidated seed model); for vmm the model file of a fit (shipgym identify --model "
+        "vmm:<term set> --json FIT.json)",
     )
     p.add_argument(
         "--angle-deg",
@@ -299,7 +306,7 @@ def build(sub: Any) -> None:
         type=float_in(1e-3, 60.0, "s"),
         default=None,
         metavar="S",
-        help="integration step [s]",
+        help="integration time step of the trial [s]",
     )
     p.add_argument("--json", default=None, metavar="OUT", help="write the results as JSON")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="write the standard figure")

@@ -249,8 +249,15 @@ def build(sub: Any) -> None:
             "the rl extra (pip install 'shipgym[rl]'); --ray the cluster extra."
         ),
     )
-    p.add_argument("--env", default=None, choices=ENV_IDS, help="environment id")
-    p.add_argument("--algo", default=None, choices=ALGOS, help="algorithm")
+    p.add_argument(
+        "--env",
+        default=None,
+        choices=ENV_IDS,
+        help="the environment id to train on (shipgym envs lists them)",
+    )
+    p.add_argument(
+        "--algo", default=None, choices=ALGOS, help="the stable-baselines3 algorithm to train"
+    )
     p.add_argument(
         "--timesteps",
         type=int_in(1, 10**9),
@@ -266,7 +273,13 @@ def build(sub: Any) -> None:
         metavar="S",
         help="seed of the networks; training sub-env i gets S + i (default 0)",
     )
-    p.add_argument("--out", default="shipgym-agents", metavar="DIR", help="%(default)s")
+    p.add_argument(
+        "--out",
+        default="shipgym-agents",
+        metavar="DIR",
+        help="folder of the agent, its checkpoints and record, made if missing "
+        "(default: %(default)s)",
+    )
     p.add_argument(
         "--num-envs",
         type=int_in(1, 65536),
@@ -339,5 +352,5 @@ def build(sub: Any) -> None:
         metavar="S1,S2,...",
         help="with --ray: train every configuration once per seed (default: 0)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or progress lines")
     p.set_defaults(handler=run)

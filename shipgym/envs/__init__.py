@@ -27,6 +27,7 @@ from shipgym.envs.heading import (
 from shipgym.envs.path_following import RVGPathFollowingEnv, RVGPathFollowingVectorEnv
 from shipgym.envs.speed import RVGSpeedEnv, RVGSpeedVectorEnv
 from shipgym.envs.target_tracking import RVGTargetTrackingEnv, RVGTargetTrackingVectorEnv
+from shipgym.models.rvg import NEWEST_RVG_PARAMETERS
 
 #: The tasks, in the order of every table.
 TASKS = ("NomotoHeading", "RVGHeading", "RVGSpeed", "RVGPathFollowing", "RVGTargetTracking")
@@ -34,7 +35,7 @@ TASKS = ("NomotoHeading", "RVGHeading", "RVGSpeed", "RVGPathFollowing", "RVGTarg
 #: Default keyword arguments per env version (``-v1``: the validated sea-trial Gunnerus).
 _VERSIONS: dict[str, dict[str, dict[str, object]]] = {
     "NomotoHeading": {"v0": {}},
-    **{task: {"v0": {}, "v1": {"params": "sea_trials"}} for task in TASKS[1:]},
+    **{task: {"v0": {}, "v1": {"params": NEWEST_RVG_PARAMETERS}} for task in TASKS[1:]},
 }
 
 #: Every registered env id.

@@ -154,8 +154,8 @@ class RVGHeadingEnv(ShipEnv):
 
     ## Arguments
 
-    ``gymnasium.make("shipgym/RVGHeading-v0", max_current_speed=0.5, max_azimuth=0.61,
-    setpoint_interval=100.0, params="seed001", render_mode=None)``. Reset options and
+    ``gymnasium.make("shipgym/RVGHeading-v1", max_current_speed=0.5, max_azimuth=0.61,
+    setpoint_interval=100.0, params="sea_trials", render_mode=None)``. Reset options and
     ``info`` as for ``NomotoHeading-v0``, with the Gunnerus' ``initial_state`` (``x``, ``y``,
     ``psi``, ``u``, ``v``, ``r``, ``T1``, ``T2``, ``alpha1``, ``alpha2``).
 

@@ -63,11 +63,11 @@ class RVGPathFollowingEnv(ShipEnv):
 
     ## Arguments
 
-    ``gymnasium.make("shipgym/RVGPathFollowing-v0", max_current_speed=0.5, max_azimuth=0.61,
-    accept_radius=67.8, max_cross_track=250.0, params="seed001", render_mode=None)``. Reset options:
-    ``current_speed``, ``current_direction``, ``initial_state``, ``waypoints`` (2 to 16
-    (north, east) points [m]). ``info`` holds ``state``, the current, ``cross_track_error``,
-    ``segment``, ``completed`` and ``termination_reason``.
+    ``gymnasium.make("shipgym/RVGPathFollowing-v1", max_current_speed=0.5, max_azimuth=0.61,
+    accept_radius=67.8, max_cross_track=250.0, params="sea_trials", render_mode=None)``.
+    Reset options: ``current_speed``, ``current_direction``, ``initial_state``, ``waypoints``
+    (2 to 16 (north, east) points [m]). ``info`` holds ``state``, the current,
+    ``cross_track_error``, ``segment``, ``completed`` and ``termination_reason``.
     Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
     range) as for ``RVGHeading-v0``, but positions (``x``, ``y`` and every waypoint's north
     and east) within +-6960 m, the distance covered in one episode at the top speed 8.7 m/s.

@@ -51,8 +51,8 @@ class RVGSpeedEnv(ShipEnv):
 
     ## Arguments
 
-    ``gymnasium.make("shipgym/RVGSpeed-v0", max_current_speed=0.5, setpoint_interval=200.0,
-    params="seed001", render_mode=None)``. Reset options: ``current_speed``,
+    ``gymnasium.make("shipgym/RVGSpeed-v1", max_current_speed=0.5, setpoint_interval=200.0,
+    params="sea_trials", render_mode=None)``. Reset options: ``current_speed``,
     ``current_direction``,
     ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s]). ``info`` holds ``state``,
     the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.

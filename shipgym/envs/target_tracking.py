@@ -55,8 +55,8 @@ class RVGTargetTrackingEnv(ShipEnv):
 
     ## Arguments
 
-    ``gymnasium.make("shipgym/RVGTargetTracking-v0", max_current_speed=0.5, distance=50.0,
-    max_distance=3000.0, params="seed001", render_mode=None)``. Reset options: ``current_speed``,
+    ``gymnasium.make("shipgym/RVGTargetTracking-v1", max_current_speed=0.5, distance=50.0,
+    max_distance=3000.0, params="sea_trials", render_mode=None)``. Reset options: ``current_speed``,
     ``current_direction``, ``initial_state``, ``target_position`` and ``target_velocity``
     ((north, east) in m and m/s), ``distance`` [m]. ``info`` holds ``state``, the current,
     ``distance``, ``distance_error`` and ``termination_reason``.

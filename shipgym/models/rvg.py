@@ -105,6 +105,8 @@ from shipgym.models.vmath import sincos
 
 RVG_PARAMETER_SETS = ("seed001", "sea_trials")
 """Names of the shipped parameter sets (:meth:`RVGParams.named`)."""
+NEWEST_RVG_PARAMETERS = "sea_trials"
+"""The newest, validated parameter set: the one the ``-v1`` envs and ``shipgym simulate`` use."""
 RVG_STATES = ("x", "y", "psi", "u", "v", "r", "T1", "T2", "alpha1", "alpha2")
 RVG_INPUTS = ("T1_c", "T2_c", "alpha1_c", "alpha2_c")
 IX, IY, IPSI, IU, IV, IR, IT1, IT2, IA1, IA2 = range(10)
