@@ -2,9 +2,9 @@
 
 Usage::
 
-    python scripts/bench_sysid.py [--root ../shared/data/measured] [--repeats 3]
+    python scripts/bench_sysid.py [--root DIR] [--repeats 3]
                                   [--effect rudder_lag] [--no-gunnerus] [--out docs]
-                                  [--readme README.md | --no-readme]
+                                  [--page docs/results/speed.md | --no-page]
 
 Times (median after a warm-up for Numba, see :func:`shipgym.sysid.report.benchmark_sysid`) a
 ``nomoto1`` output-error fit of 10 001 generated samples (goal 1 s), the whole identification
@@ -14,41 +14,48 @@ and the 3-DOF ``vmm:martin_simple`` on the 13 HSVA KVLCC2 runs together (regress
 whole loop goal 60 s); then one finite-difference Jacobian's replays of ``nomoto1`` and
 ``rvg3dof``, one at a time against side by side, in interleaved rounds (the speed-up, no goal).
 Prints each time with its goal and ratio, writes ``OUT/bench_sysid.json`` and
-``OUT/bench_sysid.png`` and, when the README has them, refreshes the block between
-``<!-- bench_sysid -->`` and ``<!-- /bench_sysid -->``. The exit code does not depend on the
-goals.
+``OUT/bench_sysid.png`` and, when the page has them, refreshes the block between
+``<!-- bench_sysid -->`` and ``<!-- /bench_sysid -->`` of ``docs/results/speed.md``. The exit
+code does not depend on the goals.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
+from shipgym.datasets import measured_root
 from shipgym.sysid.report import (
     benchmark_sysid,
     format_benchmark,
     plot_benchmark,
+    relative_link,
     update_readme,
     write_json,
 )
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_ROOT = (REPO / ".." / "shared" / "data" / "measured").resolve()
+DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--root", default=str(DEFAULT_ROOT), help="measured-data folder")
+    parser.add_argument(
+        "--root", default=str(DEFAULT_ROOT), help="measured-data folder (default: %(default)s)"
+    )
     parser.add_argument("--repeats", type=int, default=3, help="timed runs (fit: at least 3)")
     parser.add_argument("--effect", default="rudder_lag", help="effect of the loop record")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-gunnerus", action="store_true", help="skip the Gunnerus record")
     parser.add_argument("--no-kvlcc2", action="store_true", help="skip the HSVA KVLCC2 runs")
     parser.add_argument("--out", default=str(REPO / "docs"), help="output folder")
-    parser.add_argument("--readme", default=str(REPO / "README.md"))
-    parser.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    parser.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "speed.md"),
+        help="documentation page whose block to update",
+    )
+    parser.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = parser.parse_args(argv)
     out = Path(args.out)
     report = benchmark_sysid(
@@ -65,21 +72,21 @@ def main(argv: list[str] | None = None) -> int:
     json_path = write_json(report, out / "bench_sysid.json")
     png_path = plot_benchmark(report, out / "bench_sysid.png")
     written = [json_path, png_path]
-    if not args.no_readme:
-        readme = Path(args.readme)
+    if not args.no_page:
+        page = Path(args.page)
         sysinfo = report["system"]
         block = (
             f"Measured with `python scripts/bench_sysid.py` ({sysinfo['cpu_count']} CPUs, "
             f"Python {sysinfo['python']}, NumPy {sysinfo['numpy']}, SciPy {sysinfo['scipy']}, "
             f"Numba {sysinfo['numba']}); medians after a warm-up:\n\n{table}\n\n"
-            f"![sysid speed]({os.path.relpath(png_path, readme.parent)})"
+            f"![sysid speed]({relative_link(png_path, page)})"
         )
         try:
-            changed = update_readme(readme, block, "bench_sysid")
+            changed = update_readme(page, block, "bench_sysid")
         except ValueError as exc:
-            print(f"README not updated: {exc}", file=sys.stderr)
+            print(f"page not updated: {exc}", file=sys.stderr)
         else:
-            written.append(readme if changed else Path(f"{readme} (unchanged)"))
+            written.append(page if changed else Path(f"{page} (unchanged)"))
     print(f"wrote {', '.join(str(p) for p in written)}", file=sys.stderr)
     return 0
 

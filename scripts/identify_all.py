@@ -1,9 +1,9 @@
-"""Identify every measured record; JSON, Markdown report, figures and the README table.
+"""Identify every measured record; JSON, Markdown report, figures and the results page's table.
 
 Usage::
 
-    python scripts/identify_all.py [--root ../shared/data/measured] [--only SUBSTRING]
-                                   [--out docs] [--readme README.md | --no-readme]
+    python scripts/identify_all.py [--root DIR] [--only SUBSTRING]
+                                   [--out docs] [--page docs/results/identification.md | --no-page]
                                    [--models nomoto1,rvg3dof,vmm:martin_simple] [--fresh]
                                    [--render-only] [-v]
 
@@ -17,12 +17,13 @@ each run alone: fitted on its first 70 %) with a progress line per record on std
 * ``OUT/identification.png``: heading RMS before/after per record (log scale), effects
   annotated; ``OUT/identification_sspa.png`` and ``OUT/identification_gunnerus.png`` from
   :func:`shipgym.sysid.plots.plot_identification` (when that module exists);
-* the README block between ``<!-- identification -->`` and ``<!-- /identification -->``.
+* the block between ``<!-- identification -->`` and ``<!-- /identification -->`` of the results
+  page ``docs/results/identification.md``, which includes ``OUT/identification.md`` below it.
 
 With ``--only`` the new rows replace the same (record, model) rows of an existing
 ``identification.json`` and the others are kept (``--fresh`` starts over); the full run
 (no ``--only``) always starts over. ``--render-only`` rewrites the Markdown, the summary
-figure and the README from the JSON without identifying anything. ``-v`` also prints every
+figure and the page's block from the JSON without identifying anything. ``-v`` also prints every
 candidate effect of the loop. The data stay in ``--root``; nothing is copied.
 """
 
@@ -36,6 +37,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from shipgym.datasets import measured_root
 from shipgym.sysid.data import Record
 from shipgym.sysid.engine import IdentificationResult
 from shipgym.sysid.report import (
@@ -45,6 +47,7 @@ from shipgym.sysid.report import (
     merge_rows,
     plot_record,
     plot_summary,
+    relative_link,
     render_document,
     render_markdown,
     render_table,
@@ -53,16 +56,22 @@ from shipgym.sysid.report import (
 )
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_ROOT = (REPO / ".." / "shared" / "data" / "measured").resolve()
+DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--root", default=str(DEFAULT_ROOT), help="measured-data folder")
+    parser.add_argument(
+        "--root", default=str(DEFAULT_ROOT), help="measured-data folder (default: %(default)s)"
+    )
     parser.add_argument("--only", help="only records whose source/file contains this text")
     parser.add_argument("--out", default=str(REPO / "docs"), help="output folder")
-    parser.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    parser.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    parser.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "identification.md"),
+        help="documentation page whose block to update",
+    )
+    parser.add_argument("--no-page", action="store_true", help="do not touch the page")
     parser.add_argument(
         "--models",
         default=",".join(DEFAULT_MODELS),
@@ -75,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--render-only",
         action="store_true",
-        help="no identification: rewrite the Markdown, summary figure and README from the JSON",
+        help="no identification: rewrite the Markdown, summary figure and page block from the JSON",
     )
     parser.add_argument(
         "-v", "--verbose", action="store_true", help="also print every candidate effect"
@@ -161,7 +170,7 @@ def _write(
     config: dict[str, Any],
     elapsed: float,
 ) -> int:
-    """Write the JSON, the Markdown report, the summary figure and the README block."""
+    """Write the JSON, the Markdown report, the summary figure and the page's block."""
     json_path = out / "identification.json"
     write_json(
         {
@@ -184,13 +193,12 @@ def _write(
     print(render_table(rows))
     written = [json_path, out / "identification.md", out / "identification.png"]
     written += [out / v for v in figures.values()]
-    if not args.no_readme:
-        readme = Path(args.readme)
-        link = os.path.relpath(out / "identification.md", readme.parent)
-        plot = os.path.relpath(out / "identification.png", readme.parent)
-        block = render_markdown(rows, doc_link=link) + f"\n\n![heading error before/after]({plot})"
-        changed = update_readme(readme, block)
-        written.append(readme if changed else Path(f"{readme} (unchanged)"))
+    if not args.no_page:
+        page = Path(args.page)
+        plot = relative_link(out / "identification.png", page)
+        block = render_markdown(rows) + f"\n\n![heading error before/after]({plot})"
+        changed = update_readme(page, block)
+        written.append(page if changed else Path(f"{page} (unchanged)"))
     failed = [r for r in rows if r["status"] != "ok"]
     print(
         f"{len(rows)} identification(s) in {elapsed:.0f} s ({len(failed)} failed or skipped); "

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python scripts/identify_gunnerus.py [--record PATH] [--out docs] [--folds 3]
-                                        [--readme README.md | --no-readme]
+    python scripts/identify_gunnerus.py [--record PATH|DATASET] [--out docs] [--folds 3]
+                                        [--page docs/results/gunnerus.md | --no-page]
 
 1. Runs the identification loop (:func:`shipgym.sysid.identify`, ``rvg3dof``) from the seed-001
    base on the sea-trial record and draws its path: the held-out error after the base and after
@@ -18,8 +18,9 @@ Usage::
    measurement, the seed-001 model, the cross-validated model and the shipped sea-trial set
    (:meth:`shipgym.models.RVGParams.sea_trials`, fitted on the whole record) side by side
    (``OUT/gunnerus_manoeuvres.png``).
-3. Writes ``OUT/gunnerus.json`` and ``OUT/gunnerus.md`` and the README block between
-   ``<!-- gunnerus -->`` and ``<!-- /gunnerus -->``, and prints the whole-record ship
+3. Writes ``OUT/gunnerus.json`` and ``OUT/gunnerus.md`` (which ``docs/results/gunnerus.md``
+   includes from its "Every manoeuvre" on) and that page's block between ``<!-- gunnerus -->``
+   and ``<!-- /gunnerus -->``, and prints the whole-record ship
    parameters (the values of ``SEA_TRIALS_VALUES`` in :mod:`shipgym.models.rvg`).
 
 The data stay where they are; nothing is copied.
@@ -41,6 +42,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from shipgym.datasets import expand_records
 from shipgym.models import RVGParams
 from shipgym.models.rvg import SEA_TRIALS_VALUES
 from shipgym.sysid import identify, load
@@ -54,12 +56,9 @@ from shipgym.sysid.families.rvg import (
     measured_states,
     simulate_orders,
 )
-from shipgym.sysid.report import update_readme
+from shipgym.sysid.report import relative_link, update_readme
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_RECORD = (
-    REPO / ".." / "shared" / "data" / "measured" / "gunnerus_seatrials" / "RVG_ManeuveringTests.csv"
-).resolve()
 _LOOP_CHANNELS = (("psi", "heading [deg]", math.degrees), ("r", "yaw rate [deg/s]", math.degrees),
                   ("u", "surge speed [m/s]", float), ("x", "north [m]", float))  # fmt: skip
 
@@ -143,11 +142,19 @@ def not_taken(res: Any) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--record", default=str(DEFAULT_RECORD), help="the sea-trial CSV")
+    ap.add_argument(
+        "--record",
+        default="gunnerus-seatrials",
+        help="the sea-trial CSV, or its dataset name (shipgym data list; default: %(default)s)",
+    )
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
     ap.add_argument("--folds", type=int, default=3, help="cross-validation folds (>= 2)")
-    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "gunnerus.md"),
+        help="documentation page whose block to update",
+    )
+    ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     if args.folds < 2:
         ap.error(f"--folds must be >= 2, got {args.folds}")
@@ -158,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
         print(msg, file=sys.stderr, flush=True)
 
     t0 = time.perf_counter()
-    rec = load(args.record)
+    rec = load(expand_records([args.record])[0])
     res = identify(rec, "rvg3dof", progress=lambda m: say(f"  {m}"))
     loop_s = time.perf_counter() - t0
     say(f"loop: {res.effect_names} in {loop_s:.1f} s")
@@ -242,19 +249,27 @@ def main(argv: list[str] | None = None) -> int:
               f"({args.folds} folds: each is predicted by the final model fitted on the record "
               "without it, in the day's current fitted with it; the shipped `sea_trials` set, "
               "fitted on the whole record, in calm water): absolute errors against the "
-              "targets.", "", summary_md, "",
-              "![loop](docs/gunnerus_loop.png)", "",
-              "![manoeuvres](docs/gunnerus_manoeuvres.png)"]  # fmt: skip
-    block = "\n".join(lines)
-    doc_md = block.replace("docs/", "") + "\n\n## Every manoeuvre\n\n" + table + "\n"
-    (out / "gunnerus.md").write_text("# R/V Gunnerus: identification and validation\n\n" + doc_md)
-    if not args.no_readme:
-        update_readme(
-            args.readme,
-            block + "\n\nEvery manoeuvre: [docs/gunnerus.md](docs/gunnerus.md).",
-            "gunnerus",
+              "targets.", "", summary_md]  # fmt: skip
+    text = "\n".join(lines)
+
+    def with_figures(page: Path) -> str:
+        """The tables and the two figures, linked from ``page``."""
+        figures = (("loop", "gunnerus_loop.png"), ("manoeuvres", "gunnerus_manoeuvres.png"))
+        return text + "".join(
+            f"\n\n![{alt}]({relative_link(out / name, page)})" for alt, name in figures
         )
-    print(block)
+
+    doc_path = out / "gunnerus.md"
+    doc_path.write_text(
+        "# R/V Gunnerus: identification and validation\n\n"
+        + with_figures(doc_path)
+        + "\n\n## Every manoeuvre\n\n"
+        + table
+        + "\n"
+    )
+    if not args.no_page:
+        update_readme(args.page, with_figures(Path(args.page)), "gunnerus")
+    print(with_figures(doc_path))
     print("\nwhole-record ship parameters (SEA_TRIALS_VALUES):")
     for k, v in values.items():
         print(f"    {k!r}: {v:.5g},")

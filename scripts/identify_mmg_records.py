@@ -5,7 +5,7 @@ Usage::
 
     python scripts/identify_mmg_records.py [--model vmm:auto] [--seeds 6] [--effects E ...]
                                            [--n-runs 6] [--jobs 2] [--out docs]
-                                           [--readme README.md | --no-readme]
+                                           [--page docs/results/identification.md | --no-page]
                                            [--simulator shipgym|shipmmg]
 
     # the same runs with their motions made by ShipMMG, in its own environment:
@@ -35,11 +35,11 @@ model's error (the script reads the truth for it; the identification never does)
 
 With ``--simulator shipmmg`` the motions come from ShipMMG instead (:func:`shipmmg_runs`; no
 wind: ShipMMG has no wind loads), a cross-check that the counts are not an artefact of
-shipgym's own MMG code; the footprint is still shipgym's, and the outputs and README block are
-named ``mmg_records_shipmmg``.
+shipgym's own MMG code; the footprint is still shipgym's, and the outputs and the page's block
+are named ``mmg_records_shipmmg``.
 
-Writes ``OUT/mmg_records.json``, ``OUT/mmg_records.png`` and the README block between
-``<!-- mmg_records -->`` and ``<!-- /mmg_records -->``.
+Writes ``OUT/mmg_records.json``, ``OUT/mmg_records.png`` and the block between
+``<!-- mmg_records -->`` and ``<!-- /mmg_records -->`` of ``docs/results/identification.md``.
 """
 
 from __future__ import annotations
@@ -263,7 +263,7 @@ def _held(doc: dict[str, Any]) -> str:
 
 
 def render(doc: dict[str, Any]) -> str:
-    """The README block."""
+    """The page's block."""
     n = doc["n_seeds"]
     lines = [
         f"The 3-DOF loop (`{doc['model']}`) on runs of the KVLCC2 L7 model made by the MMG "
@@ -372,8 +372,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--n-runs", type=int, default=6, help="runs per record set (default 6)")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
-    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "identification.md"),
+        help="documentation page whose block to update",
+    )
+    ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     if args.seeds < 1:
         ap.error(f"--seeds must be >= 1, got {args.seeds}")
@@ -387,12 +391,12 @@ def main(argv: list[str] | None = None) -> int:
         except ImportError:
             ap.error("--simulator shipmmg: ShipMMG is not installed here (usage above)")
     name = "mmg_records" + ("" if args.simulator == "shipgym" else f"_{args.simulator}")
-    if not args.no_readme:  # before an hour of fits, not after
+    if not args.no_page:  # before an hour of fits, not after
         try:
-            text = Path(args.readme).read_text(encoding="utf-8")
+            text = Path(args.page).read_text(encoding="utf-8")
             replace_between_markers(text, name, "")
         except (OSError, ValueError) as exc:
-            ap.error(f"--readme {args.readme}: {exc} (or pass --no-readme)")
+            ap.error(f"--page {args.page}: {exc} (or pass --no-page)")
     model = args.model
     if model == DEFAULT_MODEL and model not in FAMILIES:
         _say(f"{DEFAULT_MODEL} is not registered; using {FALLBACK_MODEL}")
@@ -445,8 +449,8 @@ def main(argv: list[str] | None = None) -> int:
         )
     write_json(doc, out / f"{name}.json")
     plot(doc, out / f"{name}.png")
-    if not args.no_readme:
-        update_readme(Path(args.readme), render(doc), name)
+    if not args.no_page:
+        update_readme(Path(args.page), render(doc), name)
     _say(f"wrote {out / name}.json and .png in {doc['runtime_s']:.0f} s")
     return 0
 

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python scripts/kvlcc2_identify.py [--root ../shared/data/measured] [--out docs]
-                                      [--jobs 2] [--readme README.md | --no-readme]
+    python scripts/kvlcc2_identify.py [--root DIR] [--out docs]
+                                      [--jobs 2] [--page docs/results/kvlcc2.md | --no-page]
 
 1. **HSVA, cross-validation across runs.** For every term set and every one of the 13 HSVA
    zigzags, the VMM is fitted on the other 12 runs (inverse-dynamics regression, then the
@@ -25,8 +25,9 @@ Usage::
 4. **Esso Osaka.** The identification loop on all 15 pond runs, whose records carry the apparent
    wind.
 
-Writes ``OUT/kvlcc2_identify.json``, ``OUT/kvlcc2_identify.png`` and the README block between
-``<!-- kvlcc2_identify -->`` and ``<!-- /kvlcc2_identify -->``. The data stay where they are.
+Writes ``OUT/kvlcc2_identify.json``, ``OUT/kvlcc2_identify.png`` and the block between
+``<!-- kvlcc2_identify -->`` and ``<!-- /kvlcc2_identify -->`` of ``docs/results/kvlcc2.md``.
+The data stay where they are.
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
 from shipgym import maneuvers
+from shipgym.datasets import measured_root
 from shipgym.models import Nomoto1Params, make_model
 from shipgym.sysid import identify, load
 from shipgym.sysid.families import vmm as fv
@@ -64,7 +66,7 @@ VMM_EFFECTS = ("asymmetry",)
 """The effects of the fitted VMM: the straight-running side force of the single screw."""
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_ROOT = (REPO / ".." / "shared" / "data" / "measured").resolve()
+DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
 TERM_SETS = ("linear", "martin_simple", "martin", "norrbin3")
 SCORE_LENGTHS = 15.0  # scoring windows in ship lengths of travel (the family's default)
 MARIN_WINDOW_S = 300.0
@@ -240,11 +242,17 @@ def _fit_all(records: list[Any], term_set: str) -> Any:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--root", default=str(DEFAULT_ROOT), help="measured-data folder")
+    ap.add_argument(
+        "--root", default=str(DEFAULT_ROOT), help="measured-data folder (default: %(default)s)"
+    )
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
     ap.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
-    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "kvlcc2.md"),
+        help="documentation page whose block to update",
+    )
+    ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     ap.add_argument("--folds", help="JSON file keeping the VMM fold results between runs")
     args = ap.parse_args(argv)
     root, out = Path(args.root), Path(args.out)
@@ -366,8 +374,8 @@ def main(argv: list[str] | None = None) -> int:
     }
     write_json(doc, out / "kvlcc2_identify.json")
     plot(doc, out / "kvlcc2_identify.png")
-    if not args.no_readme:
-        update_readme(Path(args.readme), render(doc), "kvlcc2_identify")
+    if not args.no_page:
+        update_readme(Path(args.page), render(doc), "kvlcc2_identify")
     _say(f"wrote {out / 'kvlcc2_identify.json'} and .png in {time.perf_counter() - t0:.0f} s")
     return 0
 

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python scripts/kvlcc2_simman.py [--root ../shared/data/measured] [--out docs]
-                                    [--readme README.md | --no-readme]
+    python scripts/kvlcc2_simman.py [--root DIR] [--out docs]
+                                    [--page docs/results/kvlcc2.md | --no-page]
 
 Every MARIN (full scale: zigzags +-10/10, +-20/20, turning circles +-35 deg) and HSVA (7 m model:
 zigzags 5/1 ... 35/5) record is summarised by the quantities of the standard trials, measured
@@ -12,7 +12,8 @@ from the record's own rudder, heading and track. The MMG model (``kvlcc2``, Yasu
 Yoshimura 2015 coefficients; the full-scale ship for MARIN) runs the same trial with
 :func:`shipgym.maneuvers.zigzag` and :func:`shipgym.maneuvers.turning_circle`, and the same
 functions measure it. Writes ``OUT/kvlcc2_simman.json``, ``OUT/kvlcc2_simman.png`` and the
-README block between ``<!-- kvlcc2_simman -->`` and ``<!-- /kvlcc2_simman -->``.
+block between ``<!-- kvlcc2_simman -->`` and ``<!-- /kvlcc2_simman -->`` of
+``docs/results/kvlcc2.md``.
 
 The data stay where they are; nothing is copied.
 """
@@ -34,13 +35,14 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgym import maneuvers
+from shipgym.datasets import measured_root
 from shipgym.models import MMGParams, make_model
 from shipgym.models.mmg import KVLCC2_SCALE
 from shipgym.sysid import load
-from shipgym.sysid.report import update_readme, write_json
+from shipgym.sysid.report import relative_link, update_readme, write_json
 
 REPO = Path(__file__).resolve().parents[1]
-DEFAULT_ROOT = (REPO / ".." / "shared" / "data" / "measured").resolve()
+DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
 
 
 def _trial(path: Path) -> dict[str, Any] | None:
@@ -63,10 +65,16 @@ def _trial(path: Path) -> dict[str, Any] | None:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--root", default=str(DEFAULT_ROOT), help="measured data folder")
+    ap.add_argument(
+        "--root", default=str(DEFAULT_ROOT), help="measured-data folder (default: %(default)s)"
+    )
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
-    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "results" / "kvlcc2.md"),
+        help="documentation page whose block to update",
+    )
+    ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     root = Path(args.root)
     files = sorted([*root.glob("marin_kvlcc2/*.dat"), *root.glob("hsva_kvlcc2/*.dat")])
@@ -110,9 +118,9 @@ def main(argv: list[str] | None = None) -> int:
     md = render(rows)
     plot(rows, out / "kvlcc2_simman.png")
     print(md)
-    if not args.no_readme:
-        update_readme(args.readme, md + "\n\n![KVLCC2 against SIMMAN](docs/kvlcc2_simman.png)",
-                      "kvlcc2_simman")  # fmt: skip
+    if not args.no_page:
+        figure = relative_link(out / "kvlcc2_simman.png", args.page)
+        update_readme(args.page, f"{md}\n\n![KVLCC2 against SIMMAN]({figure})", "kvlcc2_simman")
     return 0
 
 

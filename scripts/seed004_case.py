@@ -2,12 +2,12 @@
 
 Usage::
 
-    python scripts/seed004_case.py [--out docs] [--readme README.md | --no-readme]
+    python scripts/seed004_case.py [--out docs] [--page docs/guide/controllers.md | --no-page]
 
 Runs :func:`shipgym.benchmark.seed004.run_seed004` with the report's gains, the design rule and
 the gains :func:`~shipgym.benchmark.seed004.tune_seed004` finds on its grid; writes
-``OUT/seed004.json``, ``OUT/seed004.png`` (tracks and cross-track errors) and the README block
-between ``<!-- seed004 -->`` and ``<!-- /seed004 -->``.
+``OUT/seed004.json``, ``OUT/seed004.png`` (tracks and cross-track errors) and the block
+between ``<!-- seed004 -->`` and ``<!-- /seed004 -->`` of ``docs/guide/controllers.md``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from shipgym.benchmark.seed004 import (
     run_seed004,
     tune_seed004,
 )
-from shipgym.sysid.report import update_readme, write_json
+from shipgym.sysid.report import relative_link, update_readme, write_json
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -35,8 +35,12 @@ REPO = Path(__file__).resolve().parents[1]
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(REPO / "docs"), help="output folder")
-    ap.add_argument("--readme", default=str(REPO / "README.md"), help="README to update")
-    ap.add_argument("--no-readme", action="store_true", help="do not touch the README")
+    ap.add_argument(
+        "--page",
+        default=str(REPO / "docs" / "guide" / "controllers.md"),
+        help="documentation page whose block to update",
+    )
+    ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     out = Path(args.out)
     runs = {"report gains (eq. 7)": run_seed004("seed004"), "design rule": run_seed004("design"),
@@ -72,9 +76,10 @@ def main(argv: list[str] | None = None) -> int:
         bw = "-" if r.omega_n != r.omega_n else f"{r.omega_n:.3f}"
         lines.append(f"| {name} | {bw} | {r.lookahead:.0f} | {r.max_straight_m:.0f} | "
                      f"{r.rms_straight_m:.0f} | {r.max_m:.0f} |")  # fmt: skip
-    lines += ["", "![seed 004's case](docs/seed004.png)"]
-    if not args.no_readme:
-        update_readme(Path(args.readme), "\n".join(lines), "seed004")
+    if not args.no_page:
+        figure = relative_link(out / "seed004.png", args.page)
+        block = "\n".join([*lines, "", f"![seed 004's case]({figure})"])
+        update_readme(Path(args.page), block, "seed004")
     print("\n".join(lines))
     return 0
 

@@ -18,7 +18,7 @@ of each agent (env and algorithm) and copies its agent and record into DIR, the 
 the sweep and trial it came from.
 
 At the end it writes ``docs/training.json``, the learning curves ``docs/training.png`` and the
-README table (unless ``--no-report``).
+table of ``docs/guide/training.md`` (unless ``--no-report``).
 """
 
 from __future__ import annotations
@@ -145,7 +145,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--jobs", type=int, default=2, help="agents trained at once (%(default)s)")
     p.add_argument("--timesteps", type=int, default=None, help="override every budget")
     p.add_argument("--seed", type=int, default=0, help="training seed (%(default)s)")
-    p.add_argument("--no-report", action="store_true", help="skip docs/ and README")
+    p.add_argument("--no-report", action="store_true", help="skip the report in docs/")
     args = p.parse_args(argv)
     if args.jobs < 1:
         p.error(f"--jobs must be >= 1, got {args.jobs}")

@@ -7,7 +7,8 @@ runs :func:`shipgym.benchmark.tuning.tune` (a grid over the classic structure's 
 parameters, scored by the mean return on the RL training seeds 0-15) and writes the record to
 ``DIR/<env>.json`` (default: the package's ``shipgym/benchmark/tuned``). It then draws
 ``docs/tuning.png`` (every candidate's training-seed return, the design rule's and the
-winner's marked) and writes the README table between the ``tuning`` markers.
+winner's marked) and writes the table between the ``tuning`` markers of
+``docs/guide/benchmark.md``.
 """
 
 from __future__ import annotations
@@ -18,7 +19,9 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
-README_MARKER = "tuning"
+PAGE = ROOT / "docs" / "guide" / "benchmark.md"
+"""The documentation page that holds the table."""
+PAGE_MARKER = "tuning"
 
 
 def _fmt(value: Any) -> str:
@@ -89,9 +92,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--only", default=None, help="tune only envs whose id contains TEXT")
     p.add_argument("--episodes", type=int, default=TUNING_EPISODES, help="per candidate")
     p.add_argument("--out", default=str(TUNED_DIR), help="record folder (%(default)s)")
-    p.add_argument("--no-report", action="store_true", help="skip docs/ and README")
+    p.add_argument("--no-report", action="store_true", help="skip the figure and the page")
     p.add_argument(
-        "--report-only", action="store_true", help="only redraw docs/ and README from the records"
+        "--report-only",
+        action="store_true",
+        help="only redraw the figure and the page's table from the records",
     )
     args = p.parse_args(argv)
     if args.episodes < 1:
@@ -110,8 +115,8 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_report:
         records = [load_tuned(e, args.out) for e in CURRENT_ENV_IDS]
         print(f"wrote {plot_tuning(records, ROOT / 'docs' / 'tuning.png')}")
-        update_readme(ROOT / "README.md", tuning_table(records), README_MARKER)
-        print("updated README.md")
+        update_readme(PAGE, tuning_table(records), PAGE_MARKER)
+        print(f"updated {PAGE.relative_to(ROOT)}")
     return 0
 
 

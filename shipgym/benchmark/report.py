@@ -1,9 +1,9 @@
-"""The README block of the benchmark: the table of ``shipgym benchmark`` and its figures.
+"""The results page of the benchmark: the tables of ``shipgym benchmark`` and its figures.
 
 :func:`render_markdown` turns the benchmark's JSON (a list of ``shipgym evaluate`` objects with
 ``condition``) and the throughput rows into Markdown; ``scripts/benchmark_readme.py`` runs the
 benchmark into ``docs/benchmark/`` and writes the block between ``<!-- benchmark -->`` and
-``<!-- /benchmark -->``.
+``<!-- /benchmark -->`` of :data:`PAGE`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,10 @@ import numpy as np
 
 from shipgym.benchmark.stats import paired_difference, verdict
 
-README_MARKER = "benchmark"
+PAGE = "docs/results/benchmark.md"
+"""The results page (relative to the repository) that holds the block."""
+PAGE_MARKER = "benchmark"
+"""Name of the block in :data:`PAGE`."""
 
 
 #: The controller every other is compared with, episode by episode.
@@ -195,10 +198,12 @@ def paired_table(entries: Sequence[dict[str, Any]], reference: str = REFERENCE) 
 def render_markdown(
     entries: Sequence[dict[str, Any]],
     throughput: Sequence[dict[str, Any]] | None,
-    figure_dir: str = "docs/benchmark",
+    figure_dir: str = "../benchmark",
 ) -> str:
     """Markdown: the nominal metrics with intervals, the paired comparison with the tuned
-    classic controller, the robustness conditions and the training throughput."""
+    classic controller, the robustness conditions and the training throughput; the figures are
+    linked in ``figure_dir``, relative to the page (default: from :data:`PAGE` to
+    ``docs/benchmark``)."""
     first = entries[0]
     stress_speeds = {
         e["env"]: e["options"].get("current_speed") for e in entries if e["condition"] == "stress"

@@ -1,10 +1,10 @@
-"""The training report of the shipped agents: table, learning curves, README block.
+"""The training report of the shipped agents: table, learning curves, documentation block.
 
 :func:`write_training_report` reads every agent record (``<name>.json``) in a folder and
 writes ``docs/training.json`` (the rows), ``docs/training.png`` (validation return against
 environment steps for PPO and SAC on each env, with the classic controller's return on the
-same validation episodes as a reference line) and the README block between
-``<!-- training -->`` and ``<!-- /training -->``.
+same validation episodes as a reference line) and the block between ``<!-- training -->`` and
+``<!-- /training -->`` of the training guide, ``docs/guide/training.md``.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ from matplotlib.figure import Figure
 from shipgym.envs import CURRENT_ENV_IDS
 from shipgym.rl.train import ALGOS, VALIDATION_SEED
 
-README_MARKER = "training"
+PAGE_MARKER = "training"
+"""Name of the block in ``docs/guide/training.md``."""
 _COLOURS = {"ppo": "#c0392b", "sac": "#2e8b57"}
 
 
@@ -110,8 +111,9 @@ def plot_learning_curves(
 
 
 def write_training_report(agent_dir: str | Path, root: str | Path) -> list[Path]:
-    """Write ``docs/training.json``, ``docs/training.png`` and the README block under ``root``."""
-    from shipgym.sysid.report import update_readme
+    """Write ``docs/training.json``, ``docs/training.png`` and the block of
+    ``docs/guide/training.md`` under ``root`` (the repository)."""
+    from shipgym.sysid.report import relative_link, update_readme
 
     rows = training_rows(agent_dir)
     if not rows:
@@ -141,8 +143,8 @@ def write_training_report(agent_dir: str | Path, root: str | Path) -> list[Path]
         "Validation return: the mean over 16 fixed validation episodes (seeds "
         f"{VALIDATION_SEED}-{VALIDATION_SEED + 15}) of the policy that was saved.\n\n"
         + render_training_table(rows)
-        + "\n\n![learning curves](docs/training.png)"
     )
-    readme = Path(root) / "README.md"
-    update_readme(readme, block, README_MARKER)
-    return [json_path, png, readme]
+    page = docs / "guide" / "training.md"
+    block += f"\n\n![learning curves]({relative_link(png, page)})"
+    update_readme(page, block, PAGE_MARKER)
+    return [json_path, png, page]

@@ -5,12 +5,14 @@
   runs :func:`shipgym.sysid.engine.identify` on every record (``nomoto1``, seed 000
   ``T r' + r = K delta``, on all of them; also ``rvg3dof``, the R/V Gunnerus 3-DOF model of
   seed 001, on the records with pod channels, i.e. the Gunnerus sea trials);
-  :func:`render_table` is the compact table, :func:`render_markdown` the README block around it
+  :func:`render_table` is the compact table, :func:`render_markdown` the block of the results
+  page (``docs/results/identification.md``) around it
   and :func:`render_document` ``docs/identification.md`` (one section per record, all
   parameters, held-out errors, the Gunnerus seed-001 / calibrated / with-effects comparison);
   :func:`plot_summary` draws the heading errors before and after, :func:`plot_record` the
   per-record figure (:func:`shipgym.sysid.plots.plot_identification`), and
-  :func:`update_readme` replaces the README block between ``<!-- identification -->`` markers.
+  :func:`update_readme` replaces a documentation page's block between ``<!-- identification -->``
+  markers (:func:`relative_link` links a page to a figure beside it).
   The script is ``scripts/identify_all.py``.
 * The speed of the loop (a first-order output-error fit of 10 000 samples, the whole loop on a
   10 000-sample record, the Gunnerus record), measured by :func:`benchmark_sysid` and shown by
@@ -61,6 +63,7 @@ __all__ = [
     "plot_record",
     "plot_summary",
     "prepare_record",
+    "relative_link",
     "render_document",
     "render_markdown",
     "render_table",
@@ -83,7 +86,8 @@ FIGURES: dict[str, tuple[str, str]] = {
 """Per-record figures of the report: source -> (model, file name in the output folder)."""
 
 README_MARKER = "identification"
-"""Name of the README block: ``<!-- identification -->`` ... ``<!-- /identification -->``."""
+"""Name of the block of ``docs/results/identification.md``: ``<!-- identification -->`` ...
+``<!-- /identification -->``."""
 
 BENCH_GOALS: dict[str, float] = {
     "fit": 1.0,
@@ -290,8 +294,8 @@ def identify_all(
     Parameters
     ----------
     root : str or pathlib.Path, optional
-        The measured-data folder (``../shared/data/measured``), read by
-        :func:`shipgym.sysid.data.load_all`. Either ``root`` or ``records``.
+        The measured-data folder (:func:`shipgym.datasets.measured_root`, filled by
+        ``shipgym data fetch all``), read by :func:`shipgym.sysid.data.load_all`. Either ``root`` or ``records``.
     records : iterable of Record, optional
         Records to identify instead of loading ``root`` (e.g. canonical CSVs read with
         :func:`shipgym.sysid.data.load`); ``meta["source"]`` and ``meta["file"]`` name them.
@@ -512,7 +516,7 @@ _TABLE_NOTES = (
 
 
 def render_markdown(rows: Sequence[Mapping[str, Any]], *, doc_link: str | None = None) -> str:
-    """The README block: the table (:func:`render_table`), how to read it and the links."""
+    """The page block: the table (:func:`render_table`), how to read it and the links."""
     ok = sum(r.get("status") == "ok" for r in rows)
     records = len({r.get("record") for r in rows})
     parts = [
@@ -753,7 +757,7 @@ def render_document(
 
 
 # ----------------------------------------------------------------------------------------------
-# README block
+# Marked blocks of the documentation pages
 # ----------------------------------------------------------------------------------------------
 def replace_between_markers(text: str, name: str, content: str) -> str:
     """Replace what lies between ``<!-- name -->`` and ``<!-- /name -->`` with ``content``.
@@ -780,8 +784,19 @@ def replace_between_markers(text: str, name: str, content: str) -> str:
     return text[: i + len(start)] + "\n" + content.strip("\n") + "\n" + text[j:]
 
 
+def relative_link(target: str | Path, page: str | Path) -> str:
+    """The link from the Markdown page ``page`` to ``target`` (a figure, another page).
+
+    Relative to the page's folder, with ``/`` as the separator whatever the system, as Markdown
+    and Sphinx expect: ``relative_link("docs/training.png", "docs/guide/training.md")`` is
+    ``"../training.png"``.
+    """
+    return Path(os.path.relpath(Path(target), Path(page).parent)).as_posix()
+
+
 def update_readme(path: str | Path, content: str, name: str = README_MARKER) -> bool:
-    """Rewrite the ``name`` block of the README at ``path``; True if the file changed.
+    """Rewrite the ``name`` block of the Markdown page (the README or a documentation page) at
+    ``path``; True if the file changed.
 
     Raises
     ------
