@@ -295,7 +295,8 @@ def identify_all(
     ----------
     root : str or pathlib.Path, optional
         The measured-data folder (:func:`shipgym.datasets.measured_root`, filled by
-        ``shipgym data fetch all``), read by :func:`shipgym.sysid.data.load_all`. Either ``root`` or ``records``.
+        ``shipgym data fetch all``), read by :func:`shipgym.sysid.data.load_all`. Either
+        ``root`` or ``records``.
     records : iterable of Record, optional
         Records to identify instead of loading ``root`` (e.g. canonical CSVs read with
         :func:`shipgym.sysid.data.load`); ``meta["source"]`` and ``meta["file"]`` name them.
