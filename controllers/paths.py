@@ -452,7 +452,7 @@ class FilletPath(_PiecewisePath):
     corner is cut by an arc of radius ``R`` tangent to both legs; it starts and ends
     ``R tan(|theta_i| / 2)`` before and after the waypoint. The path is tangent-continuous;
     its curvature is ``+1/R`` (starboard turn) or ``-1/R`` (port turn) on the arcs and 0 on the
-    lines, and its length is
+    lines, and its length is::
 
         sum(leg lengths) - sum_i (2 R tan(|theta_i| / 2) - R |theta_i|).
 

@@ -78,7 +78,7 @@ class TurningResult:
         Speed [m/s] at heading changes of 10, 20, ..., 180 deg [rad] (seed 002 Table 3).
     rudder_time, steady_time : float
         End of the first phase (rudder at its order) and start of the third (steady) phase
-        (|r - r_steady| < 2 % from then on) [s] (seed 002 Table 1).
+        (``|r - r_steady|`` < 2 % from then on) [s] (seed 002 Table 1).
     steady : bool
         Yaw rate and speed settled within the longest hold.
     """

@@ -95,7 +95,7 @@ SIMD_LANES = 8
 
 @row_kernel
 def _cols(col, X, U, p, C, K, n):
-    """Derivative of ships ``0 .. n-1`` of a block by the per-ship model function ``col``
+    """Derivative of ships ``range(n)`` of a block by the per-ship model function ``col``
     (``nomoto1_col``, ...): a loop of straight-line code that compiles to SIMD instructions."""
     for b in range(n):
         col(X, U, p, C, K, b)
@@ -113,7 +113,7 @@ def _rvg_cols(col, X, U, p, C, K, n):
 
 @row_kernel
 def block_rhs(model_id, X, U, p, C, K, n):
-    """State derivative of ships ``0 .. n-1`` of a block (columns of ``X``, ``U``, ``C``) of an
+    """State derivative of ships ``range(n)`` of a block (columns of ``X``, ``U``, ``C``) of an
     environment model (the Nomoto family and the RVG), written into ``K``.
 
     The model is chosen once per block; each model's loop over the ships is straight-line
@@ -163,7 +163,7 @@ def _rk4(block_deriv, model, nx, X, U, p, C, h, n, W):
 
 @row_kernel
 def rk4_block(model_id, X, U, p, C, h, n, W):
-    """Advance ships ``0 .. n-1`` of the block ``X`` (states x ships) in place by one classic
+    """Advance ships ``range(n)`` of the block ``X`` (states x ships) in place by one classic
     RK4 step of ``h`` [s] with the inputs ``U`` and current ``C`` held (seed 001 eq. 2).
 
     ``W`` is scratch of shape ``(3, nx, >= n)``: the slope of a stage, the running sum
@@ -243,7 +243,7 @@ def _scatter(XB, rows, start, n, x, nx):
 
 @row_kernel
 def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
-    """Copy ships ``rows[start .. start + n - 1]`` of the batch (ships as rows; ``nx`` states,
+    """Copy ships ``rows[start:start + n]`` of the batch (ships as rows; ``nx`` states,
     ``nu`` inputs) into a block."""
     if n == BLOCK:
         _gather(x, u, c, rows, start, BLOCK, XB, UB, CB, nx, nu)
@@ -255,7 +255,7 @@ def gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
 
 @row_kernel
 def scatter_rows(XB, rows, start, n, x, nx):
-    """Copy the block's ``nx`` states back to rows ``rows[start .. start + n - 1]`` of ``x``."""
+    """Copy the block's ``nx`` states back to rows ``rows[start:start + n]`` of ``x``."""
     if n == BLOCK:
         _scatter(XB, rows, start, BLOCK, x, nx)
     elif n == 1:
@@ -266,7 +266,7 @@ def scatter_rows(XB, rows, start, n, x, nx):
 
 @row_kernel
 def rk4_block_of(full_block, model_id, X, U, p, C, h, n, W):
-    """:func:`rk4_block` of ships ``0 .. n-1`` of a block, a full block by ``full_block``
+    """:func:`rk4_block` of ships ``range(n)`` of a block, a full block by ``full_block``
     (:func:`full_block_any`, :func:`full_block_by_model` or :func:`full_block_rvg`; the same
     numbers, more or less code).
 
@@ -287,7 +287,7 @@ def rk4_block_of(full_block, model_id, X, U, p, C, h, n, W):
 
 @row_kernel
 def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
-    """One RK4 step of ships ``rows[start .. start + n - 1]`` of a batch (ships as rows): copied
+    """One RK4 step of ships ``rows[start:start + n]`` of a batch (ships as rows): copied
     into the block work arrays ``work`` (:func:`block_work`), stepped by :func:`rk4_block_of`
     and copied back."""
     XB, UB, CB, W = work

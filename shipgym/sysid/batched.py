@@ -60,7 +60,7 @@ class SideBySide:
 
 
 def lanes(variants: int) -> np.ndarray:
-    """Which variant each ship of a block replays: ``0 .. variants - 1``, and for several
+    """Which variant each ship of a block replays: ``range(variants)``, and for several
     variants the last again up to a multiple of
     :data:`~shipgym.models.integrate.SIMD_LANES`, so that the loops over the ships run in whole
     SIMD vectors (a remainder would run one ship at a time). One variant is a block of one.

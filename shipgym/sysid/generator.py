@@ -19,36 +19,36 @@ written here. Two base models:
 Effects of the ``"nomoto1"`` base (:data:`EFFECTS_BY_BASE`; ``magnitude`` is in the unit given,
 the default in brackets):
 
-=================== ===========================================================================
-effect              definition
-=================== ===========================================================================
-``rudder_offset``   The rudder needed for straight running is ``delta_0`` [rad] (2 deg): the
-                    true ship is Norrbin's model (seed 002 eq. 1) with the same K, T and
-                    ``n0 = K delta_0``, ``n1 = 1``, ``n2 = n3 = 0``, i.e.
-                    ``T r' + r = K (delta - delta_0)``. The recorded rudder is the steering-gear
-                    state; it does NOT contain the offset.
+==================== ===========================================================================
+effect               definition
+==================== ===========================================================================
+``rudder_offset``    The rudder needed for straight running is ``delta_0`` [rad] (2 deg): the
+                     true ship is Norrbin's model (seed 002 eq. 1) with the same K, T and
+                     ``n0 = K delta_0``, ``n1 = 1``, ``n2 = n3 = 0``, i.e.
+                     ``T r' + r = K (delta - delta_0)``. The recorded rudder is the steering-gear
+                     state; it does NOT contain the offset.
 ``yaw_nonlinearity`` Norrbin cubic term: the true ship is ``T r' + n3 r^3 + r = K delta``
-                    (seed 002 eq. 1, seed 004 eq. 4) with ``n3`` [s^2] (2.9e3, the shipgym
-                    default), ``n0 = n2 = 0``, ``n1 = 1``.
-``rudder_lag``      The recorded rudder is the COMMAND ``delta_c``, while the actual rudder
-                    follows it through a slow gear: first-order time constant ``T_delta`` [s]
-                    (8 s) with the default angle and rate limits (seed 002 eq. 2).
-``input_delay``     The recorded rudder leads the rudder the ship feels by a pure delay
-                    ``tau`` [s] (3 s, rounded to the internal step): the ship responds to
-                    ``delta(t - tau)`` where ``delta`` is the recorded gear angle (as if the
-                    rudder log's clock were ``tau`` ahead, or a transport delay between the
-                    measured angle and the hydrodynamic force). In the zigzag the controller
-                    acts on the measured heading, so its switching is delayed too.
-``current``         A constant irrotational current of speed ``V_c`` [m/s] (0.5 m/s) toward a
-                    direction drawn from the seed (uniform on [0, 2 pi)), entering only the
-                    kinematics ``x' = U cos psi + V_n``, ``y' = U sin psi + V_e``. A Nomoto
-                    model's yaw is unaffected by a uniform current, so only position-based
-                    criteria (dead reckoning against the recorded track) can see it.
-``second_order``    The true ship is the second-order Nomoto model (seed 004 eq. 1) with the
-                    Mariner ``K = 0.185``, ``T2`` [s] (7.8 s), ``T3 = 18.5 s`` and
-                    ``T1 = T + T3 - T2`` (118 s), so its first-order equivalent
-                    ``T1 + T2 - T3`` equals the base ``T``.
-=================== ===========================================================================
+                     (seed 002 eq. 1, seed 004 eq. 4) with ``n3`` [s^2] (2.9e3, the shipgym
+                     default), ``n0 = n2 = 0``, ``n1 = 1``.
+``rudder_lag``       The recorded rudder is the COMMAND ``delta_c``, while the actual rudder
+                     follows it through a slow gear: first-order time constant ``T_delta`` [s]
+                     (8 s) with the default angle and rate limits (seed 002 eq. 2).
+``input_delay``      The recorded rudder leads the rudder the ship feels by a pure delay
+                     ``tau`` [s] (3 s, rounded to the internal step): the ship responds to
+                     ``delta(t - tau)`` where ``delta`` is the recorded gear angle (as if the
+                     rudder log's clock were ``tau`` ahead, or a transport delay between the
+                     measured angle and the hydrodynamic force). In the zigzag the controller
+                     acts on the measured heading, so its switching is delayed too.
+``current``          A constant irrotational current of speed ``V_c`` [m/s] (0.5 m/s) toward a
+                     direction drawn from the seed (uniform on [0, 2 pi)), entering only the
+                     kinematics ``x' = U cos psi + V_n``, ``y' = U sin psi + V_e``. A Nomoto
+                     model's yaw is unaffected by a uniform current, so only position-based
+                     criteria (dead reckoning against the recorded track) can see it.
+``second_order``     The true ship is the second-order Nomoto model (seed 004 eq. 1) with the
+                     Mariner ``K = 0.185``, ``T2`` [s] (7.8 s), ``T3 = 18.5 s`` and
+                     ``T1 = T + T3 - T2`` (118 s), so its first-order equivalent
+                     ``T1 + T2 - T3`` equals the base ``T``.
+==================== ===========================================================================
 
 Effects of the ``"rvg3dof"`` base (the clean ship, ``effect=None``, is seed 001's model: no pod
 lift, no offset, no current):

@@ -70,7 +70,7 @@ def _number(value: Any, digits: int = 4) -> str:
 
 
 def format_errors(before: Mapping[str, Any], after: Mapping[str, Any]) -> str:
-    """``"psi RMS 11.64 -> 0.09716 deg, r RMS ... deg/s, ..."`` for the keys of both dicts.
+    """The errors of both dicts, key by key: ``"psi RMS 11.64 -> 0.09716 deg, r RMS ..."``.
 
     Parameters
     ----------

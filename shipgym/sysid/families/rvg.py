@@ -33,7 +33,7 @@ a documented physical range, so that a factor cannot stand in for a missing effe
 constant, 10 deg/s azimuth rate); the azimuth time constant, the servo between the logged order
 and the pods, is the ``rudder_lag`` effect, which the loop takes only by its criterion.
 
-=========================== ============== =========================================================
+=========================== =============== ========================================================
 ``bollard_thrust``           x0.59 .. x1.1  the Kongsberg pod table (121.7 kN at 200 rpm) is the
                                             open-water thrust at the shaft speed; the record's
                                             rpm is the *order* (percent x 2.185; the trial log
@@ -50,7 +50,7 @@ and the pods, is the ``rudder_lag`` effect, which the loop takes only by its cri
                                             MCSim's 4-DOF cross-flow drag uses 1.2-2.4)
 ``yaw_quadratic_damping``    2.87e7..3.65e8 between the cross-flow-consistent D_v L^3 / 32 and the
                                             source's dimensionally dubious 0.75 D_v L^4 / 64
-=========================== ============== =========================================================
+=========================== =============== ========================================================
 
 Effects (:data:`RVG_EFFECTS`, each a documented term of :mod:`shipgym.models.rvg`)
 -------------------------------------------------------------------------------------
