@@ -357,3 +357,22 @@ def test_cli_identify_takes_a_dataset_name(tmp_path: Path) -> None:
     record = MIRROR / "sspa_blog_zigzag" / "example_zigzag.csv"
     assert out.startswith(f"shipgym identify {record} (sspa, 2073 samples")
     assert out_json.is_file()
+
+
+def test_the_measured_data_page_lists_the_registry() -> None:
+    """The table of ``docs/guide/data.md`` is the registry's, row for row."""
+    from shipgym.datasets import format_size, list_datasets
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "data.md").read_text()
+    rows = [
+        [c.strip().strip("`") for c in line.strip().strip("|").split("|")]
+        for line in page.splitlines()
+        if line.startswith("| `")
+    ]
+    names = {d.name for d in list_datasets()}
+    rows = [row for row in rows if row[0] in names or "-" in row[0]]
+    expected = [
+        [d.name, d.vessel, d.kind, d.runs, format_size(sum(f.size for f in d.files)), d.licence]
+        for d in list_datasets()
+    ]
+    assert rows == expected
