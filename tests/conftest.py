@@ -23,9 +23,6 @@ import pytest
 #: the session's folder, made by the process that runs pytest and shared by its xdist workers
 _ROOT_VARIABLE = "SHIPGYM_TEST_ROOT"
 _PYTEST_DIR = "pytest"
-#: torch makes its compiler cache folder ``torchinductor_<user>`` in the temporary directory
-#: when an optimiser is built; that is torch's cache, not a file a run forgot
-_THIRD_PARTY_CACHES = ("torchinductor_",)
 #: the project's local mirror of the measured datasets, beside the checkout (as in CI): the
 #: tests read the records there in place unless ``SHIPGYM_MEASURED_DATA`` names another copy
 _MEASURED_MIRROR = Path(__file__).resolve().parents[2] / "shared" / "data" / "measured"
@@ -73,7 +70,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     left = sorted(
         p.name
         for p in _root().iterdir()
-        if p.name != _PYTEST_DIR and not p.name.startswith(_THIRD_PARTY_CACHES)
+        if p.name != _PYTEST_DIR
     )
     if left:
         reporter = session.config.pluginmanager.get_plugin("terminalreporter")

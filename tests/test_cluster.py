@@ -3,8 +3,8 @@
 One local Ray with 2 CPUs serves the whole module (its files in a private temporary folder that
 the session removes). The results of ``--ray`` equal those of the local run exactly (the
 campaign split into tasks of a few seeds), a failing episode is reported with its env,
-controller, condition and seed, bad ``--ray`` values are one-line errors, and RLlib's remote
-env runners make the envs from the id with its module prefix.
+controller, condition and seed, and bad ``--ray`` values are one-line errors. RLlib's tests are
+in ``test_rllib.py``.
 """
 
 from __future__ import annotations
@@ -193,34 +193,3 @@ def test_failing_task_is_reported_with_its_seed(local_ray, capsys) -> None:
         ENV, "classic", "faulty", (seed,)
     )  # fmt: skip
     assert "worker traceback" in "".join(getattr(info.value, "__notes__", []))
-
-
-# ---- RLlib --------------------------------------------------------------------------------
-def test_rllib_remote_env_runner_makes_the_env_from_the_prefixed_id(
-    local_ray, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """RLlib's env runners are fresh processes that never import shipgym: the id with its module
-    prefix (``shipgym:``) imports it there; one PPO iteration on one remote runner."""
-    pytest.importorskip("ray.rllib", reason="RLlib is not installed (pip install 'shipgym[rllib]')")
-    from ray.rllib.algorithms.ppo import PPOConfig
-    from ray.tune.trainable import trainable
-
-    # an algorithm outside Tune logs into ~/ray_results: keep the test's folder there instead
-    monkeypatch.setattr(trainable, "DEFAULT_STORAGE_PATH", str(tmp_path))
-
-    config = (
-        PPOConfig()
-        .environment("shipgym:shipgym/NomotoHeading-v0")
-        .env_runners(num_env_runners=1, num_envs_per_env_runner=1, rollout_fragment_length=64)
-        .training(train_batch_size_per_learner=64, minibatch_size=32, num_epochs=1)
-        .rl_module(model_config={"fcnet_hiddens": [16]})
-        .debugging(seed=0)
-    )
-    algo = config.build_algo()
-    try:
-        result = algo.train()
-    finally:
-        algo.stop()
-    runners = result["env_runners"]
-    assert runners["num_env_steps_sampled_lifetime"] >= 64
-    assert result["num_env_steps_sampled_lifetime"] >= 64

@@ -30,6 +30,28 @@ path; it is at least :attr:`TopDownRenderer.min_span_lengths` ship lengths and a
 :attr:`TopDownRenderer.max_span_lengths` ship lengths across the shorter image side. It
 widens at once when needed and narrows gradually, so animations do not jitter.
 
+Recording videos
+----------------
+Gymnasium's :class:`gymnasium.wrappers.RecordVideo` writes the ``"rgb_array"`` frames of an
+env to MP4 files through MoviePy, which the ``video`` extra installs
+(``pip install 'shipgym[video]'``; it brings MoviePy and the ffmpeg binary of
+``imageio-ffmpeg``). An env plays at ``render_fps = 1 / dt`` frames per second (real time:
+2 for the Gunnerus envs, 1 for ``NomotoHeading``); ``fps`` speeds the video up::
+
+    import gymnasium as gym
+    from gymnasium.wrappers import RecordVideo
+
+    import shipgym
+
+    env = gym.make("shipgym/RVGPathFollowing-v1", render_mode="rgb_array")
+    env = RecordVideo(env, "videos", episode_trigger=lambda episode: episode == 0, fps=20)
+    obs, info = env.reset(seed=0)
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        done = terminated or truncated
+    env.close()  # writes videos/rl-video-episode-0.mp4
+
 Examples
 --------
 >>> import numpy as np

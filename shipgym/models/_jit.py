@@ -44,6 +44,8 @@ from llvmlite import __version__ as llvm_version
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, _CacheLocator
 from numba.extending import overload
 
+from shipgym._cache import cache_root
+
 F = TypeVar("F", bound=Callable[..., Any])
 
 _CACHE = os.environ.get("SHIPGYM_NO_CACHE", "") in ("", "0")
@@ -131,9 +133,7 @@ def _cache_dir() -> str:
     for path in _kernel_sources(site):
         digest.update(path.relative_to(site).as_posix().encode() + b"\n")
         digest.update(hashlib.sha256(path.read_bytes()).digest())
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    root = os.environ.get("SHIPGYM_CACHE_DIR") or os.path.join(base, "shipgym")
-    return os.path.join(root, f"numba-{digest.hexdigest()[:16]}")
+    return os.path.join(cache_root(), f"numba-{digest.hexdigest()[:16]}")
 
 
 CACHE_DIR = _cache_dir() if _CACHE else ""

@@ -10,12 +10,22 @@
   evaluation policies.
 
 Needs the ``rl`` extra: ``pip install 'shipgym[rl]'``.
+
+Importing this package points torch's compiler cache (``TORCHINDUCTOR_CACHE_DIR``) into
+shipgym's cache folder (``$SHIPGYM_CACHE_DIR/torchinductor``, ``~/.cache/shipgym/torchinductor``
+by default) unless it is set already. torch 2.13 makes that folder when it imports
+``torch._dynamo``, which it does the first time an optimiser is built (SB3 builds one to make
+or load a model): by default in the temporary directory, ``/tmp/torchinductor_<user>``, where
+it would outlive every command. shipgym compiles nothing with torch, so the folder stays
+empty; torch's own discussion of the default is pytorch/pytorch#121122.
 """
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
+from shipgym._cache import cache_root
 from shipgym.rl.agents import AGENT_DIR, AgentPolicy, load_agent, load_meta
 from shipgym.rl.train import (
     ALGOS,
@@ -25,6 +35,17 @@ from shipgym.rl.train import (
     resume,
     train,
 )
+
+
+def _keep_torch_cache_out_of_tmp() -> None:
+    """Set ``TORCHINDUCTOR_CACHE_DIR`` to shipgym's cache folder unless it is set (before
+    torch reads it: at the import of ``torch._dynamo``)."""
+    if "TORCHINDUCTOR_CACHE_DIR" in os.environ:
+        return
+    os.environ["TORCHINDUCTOR_CACHE_DIR"] = os.path.join(cache_root(), "torchinductor")
+
+
+_keep_torch_cache_out_of_tmp()
 
 
 def __getattr__(name: str) -> Any:

@@ -51,6 +51,35 @@ class ShipgymVecEnv(VecEnv):
         ``keep_options``), so every episode of the run has e.g. the given current.
     **env_kwargs
         Keyword arguments of the env (e.g. ``max_current_speed``).
+
+    Notes
+    -----
+    The adapter records no episode statistics of its own. SB3 reads episode returns and
+    lengths from a ``Monitor`` (``info["episode"]``): wrap the adapter in SB3's
+    :class:`~stable_baselines3.common.vec_env.VecMonitor` wherever they are read, for
+    ``evaluate_policy``, the ``rollout/ep_rew_mean`` of training logs and ``EvalCallback``.
+    Bare, ``evaluate_policy`` warns that the env is not wrapped with a ``Monitor`` and
+    returns no episode reward it could check.
+
+    Examples
+    --------
+    Evaluate a policy on 4 sub-envs, every evaluation on the same episodes (seeds 100 to 103):
+
+    >>> from stable_baselines3 import PPO
+    >>> from stable_baselines3.common.evaluation import evaluate_policy
+    >>> from stable_baselines3.common.vec_env import VecMonitor
+    >>> from shipgym.rl.vec_env import ShipgymVecEnv
+    >>> env = VecMonitor(ShipgymVecEnv("shipgym/RVGHeading-v1", num_envs=4, fixed_seed=100))
+    >>> model = PPO("MlpPolicy", env, seed=0)
+    >>> returns, lengths = evaluate_policy(model, env, n_eval_episodes=4,
+    ...                                    return_episode_rewards=True)
+    >>> [int(n) for n in lengths]  # every episode ran to the time limit
+    [600, 600, 600, 600]
+
+    ``returns[i]`` is the sum of the rewards of an episode: with ``fixed_seed``, that of a
+    single env ``gymnasium.make("shipgym/RVGHeading-v1")`` reset with seed ``100 + i`` and
+    stepped with the same actions. Training wraps it the same way, with ``VecNormalize``
+    outside the ``VecMonitor`` (so the monitor sums the unnormalised rewards).
     """
 
     def __init__(
