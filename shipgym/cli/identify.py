@@ -12,30 +12,6 @@ from typing import Any
 from shipgym._io import write_atomically
 from shipgym.cli._common import finite_float, float_in, int_in, output_path
 
-# parameter name -> unit (the Nomoto family and the effects' own parameters; others unitless)
-_PARAM_UNITS: dict[str, str] = {
-    "K": "1/s",
-    "T": "s",
-    "T1": "s",
-    "T2": "s",
-    "T3": "s",
-    "T_d": "s",
-    "tau": "s",
-    "delta0": "rad",
-    "b0": "rad",
-    "alpha_0": "rad",
-    "n0": "rad/s",
-    "n1": "-",
-    "n2": "s",
-    "n3": "s^2",
-    "b1": "s",
-    "b2": "s^2",
-    "b3": "s^3",
-    "V_n": "m/s",
-    "V_e": "m/s",
-    "speed": "m/s",
-}
-
 
 def _window(text: str) -> float | str | None:
     """``--window``: a positive number of seconds, ``auto`` or ``none``."""
@@ -56,14 +32,17 @@ def _window(text: str) -> float | str | None:
 def _format_value(name: str, value: Any, digits: int = 6, unit: bool = False) -> str:
     """``value`` with ``digits`` significant digits; angles [rad] also in degrees.
 
-    ``unit``: append the unit of :data:`_PARAM_UNITS` (before the degrees).
+    ``unit``: append the unit of :data:`shipgym.sysid.units.PARAMETER_UNITS` (before the
+    degrees).
     """
+    from shipgym.sysid.units import PARAMETER_UNITS
+
     if value is None:
         return "n/a"
     if isinstance(value, bool) or not isinstance(value, int | float):
         return str(value)
     text = f"{value:.{digits}g}"
-    known = _PARAM_UNITS.get(name)
+    known = PARAMETER_UNITS.get(name)
     if unit and known:
         text += f" {known}"
     if known == "rad" and math.isfinite(value):
@@ -72,7 +51,9 @@ def _format_value(name: str, value: Any, digits: int = 6, unit: bool = False) ->
 
 
 def _param_label(name: str) -> str:
-    unit = _PARAM_UNITS.get(name)
+    from shipgym.sysid.units import PARAMETER_UNITS
+
+    unit = PARAMETER_UNITS.get(name)
     return f"{name} [{unit}]" if unit else name
 
 

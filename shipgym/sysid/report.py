@@ -48,6 +48,7 @@ import numpy as np
 from shipgym.sysid.data import ProgressArg, Record, load, load_all, progress_printer
 from shipgym.sysid.engine import IdentificationResult, identify
 from shipgym.sysid.families.base import FAMILIES, window_starts
+from shipgym.sysid.units import PARAMETER_UNITS
 
 __all__ = [
     "BENCH_GOALS",
@@ -132,24 +133,6 @@ _EFFECT_SHORT = {
     "thruster_lift": "pod lift",
     "azimuth_offset": "azi offset",
     "sway_offset": "sway offset",
-}
-_UNITS = {
-    "K": "1/s",
-    "T": "s",
-    "T1": "s",
-    "T2": "s",
-    "T3": "s",
-    "T_d": "s",
-    "tau": "s",
-    "V_n": "m/s",
-    "V_e": "m/s",
-    "speed": "m/s",
-    "delta0": "rad",
-    "alpha_0": "rad",
-    "alpha_0_deg": "deg",
-    "direction": "rad",
-    "v_0": "m/s",
-    "pod_lift_coefficient": "N s^2/m^2",
 }
 _ERROR_COLUMNS = (
     ("psi_rms_deg", "ψ RMS [deg]"),
@@ -553,8 +536,8 @@ def _param_lines(params: Mapping[str, Any] | None) -> str:
         return "—"
     out = []
     for k, v in params.items():
-        unit = _UNITS.get(k, "")
-        text = f"{k} = {_fmt(v, 4)}" + (f" {unit}" if unit else "")
+        unit = PARAMETER_UNITS.get(k, "")
+        text = f"{k} = {_fmt(v, 4)}" + (f" {unit}" if unit not in ("", "-") else "")
         if unit == "rad" and _finite(v):
             text += f" ({_fmt(math.degrees(v), 3)} deg)"
         out.append(text)

@@ -17,6 +17,7 @@ import numpy as np
 __all__ = [
     "CHANNELS",
     "KNOT",
+    "PARAMETER_UNITS",
     "REQUIRED_INPUTS",
     "UNITS",
     "UNIT_SPELLINGS",
@@ -27,6 +28,36 @@ __all__ = [
 
 KNOT: float = 1852.0 / 3600.0
 """Metres per second in one knot."""
+
+PARAMETER_UNITS: dict[str, str] = {
+    "K": "1/s",
+    "T": "s",
+    "T1": "s",
+    "T2": "s",
+    "T3": "s",
+    "T_d": "s",
+    "tau": "s",
+    "delta0": "rad",
+    "b0": "rad",
+    "alpha_0": "rad",
+    "alpha_0_deg": "deg",
+    "direction": "rad",
+    "n0": "rad/s",
+    "n1": "-",
+    "n2": "s",
+    "n3": "s^2",
+    "b1": "s",
+    "b2": "s^2",
+    "b3": "s^3",
+    "V_n": "m/s",
+    "V_e": "m/s",
+    "v_0": "m/s",
+    "speed": "m/s",
+    "pod_lift_coefficient": "N s^2/m^2",
+}
+"""Unit of each identified parameter that has one: the Nomoto family's and the effects' own
+parameters (``"-"``: dimensionless; the 3-DOF hydrodynamic coefficients are non-dimensional and
+absent). The identification report and ``shipgym identify`` print parameters with them."""
 
 _DEG = math.pi / 180.0
 
