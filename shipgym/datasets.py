@@ -625,7 +625,15 @@ def _transfer(source: str, target: Path, size: int, label: str, bar: bool) -> No
             import pooch
 
             downloader = pooch.HTTPDownloader(progressbar=False if progress is None else progress)
-            downloader(source, str(target), None)
+            try:
+                downloader(source, str(target), None)
+            except OSError as exc:  # requests' errors are OSErrors with pages of detail
+                status = getattr(getattr(exc, "response", None), "status_code", None)
+                reason = f"HTTP {status}" if status else type(exc).__name__
+                raise OSError(
+                    f"cannot download {source} ({reason}); check the address and the "
+                    f"connection, or set ${MIRROR_ENV} to a copy laid out like the measured folder"
+                ) from exc
         else:
             with open(source, "rb") as src, open(target, "wb") as dst:
                 while chunk := src.read(_CHUNK):

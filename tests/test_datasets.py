@@ -266,9 +266,23 @@ def test_fetch_over_http_with_pooch(
     assert f"from {url} into {folder}" in err and "example_zigzag.csv" in err and "100%" in err
     # a missing file on the server: an OSError (HTTP 404), nothing kept
     (root / "usv_field" / "zigzag_30_inter_xy.csv").unlink()
-    with pytest.raises(OSError, match="404"):
+    with pytest.raises(OSError, match=r"cannot download .*zigzag_30_inter_xy.csv \(HTTP 404\)"):
         datasets.fetch("usv-field", progress=False, mirror=url)
     assert _files_under(cache / "usv_field") == {"turnningdata_xy.csv"}
+
+
+def test_fetch_without_a_connection_says_what_to_do(cache: Path) -> None:
+    """Nothing listens on port 1: one line naming the file, the failure and the mirror
+    variable, not the pages of a connection error."""
+    with pytest.raises(OSError) as info:
+        datasets.fetch("sspa-zigzag", progress=False, mirror="http://127.0.0.1:1")
+    message = str(info.value)
+    assert message.startswith("cannot download http://127.0.0.1:1/sspa_blog_zigzag/")
+    assert "(ConnectionError)" in message and "SHIPGYM_DATA_MIRROR" in message
+    assert "\n" not in message and len(message) < 300
+    assert not (cache / "sspa_blog_zigzag").exists() or not any(
+        (cache / "sspa_blog_zigzag").iterdir()
+    )
 
 
 # ------------------------------------------------------------------------------------------
