@@ -19,9 +19,14 @@ pytestmark = pytest.mark.xdist_group("test_rllib")
 
 
 @pytest.fixture(scope="module")
-def local_ray():
-    with ray_session(num_cpus=2) as ray:
-        yield ray
+def local_ray(tmp_path_factory: pytest.TempPathFactory):
+    # RLlib builds torch optimisers in the driver and in Ray's workers, which makes torch
+    # create its compiler cache folder (by default torchinductor_<user> in the temporary
+    # directory); the workers inherit this variable from the driver when Ray starts
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("TORCHINDUCTOR_CACHE_DIR", str(tmp_path_factory.mktemp("torchinductor")))
+        with ray_session(num_cpus=2) as ray:
+            yield ray
 
 
 def test_rllib_remote_env_runner_makes_the_env_from_the_prefixed_id(
