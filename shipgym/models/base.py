@@ -8,7 +8,7 @@ python-control response object).
 Every method checks its arguments in Python before a compiled kernel sees them (the kernels do
 no bounds checking): shapes against the model's states and inputs, real numbers (``TypeError``
 otherwise), finite values, a finite step > 0 within the model's stable RK4 step (``ValueError``
-naming the argument, what it was and what was expected). See :class:`ShipModel`, "Checks".
+naming the argument, what it was and what was expected). See :class:`ShipModel`, Notes.
 """
 
 from __future__ import annotations
@@ -119,12 +119,12 @@ class ShipModel:
         (:class:`~shipgym.models.delay.DelayLine`); :meth:`step`, :meth:`deriv` and
         :meth:`linearize` are the delay-free dynamics.
 
-    Checks
-    ------
-    States, inputs and currents must be real numbers (``TypeError`` for bool, complex, strings,
-    objects) of the model's shape and finite; ``dt`` a real, finite number > 0 (``ValueError``
-    naming what was wrong). A policy given to :meth:`simulate` must return a finite input of
-    shape ``(nu,)``.
+    Notes
+    -----
+    **Checks.** States, inputs and currents must be real numbers (``TypeError`` for bool,
+    complex, strings, objects) of the model's shape and finite; ``dt`` a real, finite number > 0
+    (``ValueError`` naming what was wrong). A policy given to :meth:`simulate` must return a
+    finite input of shape ``(nu,)``.
 
     A fixed-step RK4 beyond its stability limit does not give a rough answer but one that grows
     without bound (NaN or 1e235 after a while), so a step beyond the limit is refused, not
@@ -463,7 +463,7 @@ class ShipModel:
         Raises
         ------
         TypeError, ValueError
-            For bad arguments (class docstring, "Checks"), a step beyond the stable RK4 step
+            For bad arguments (class docstring, Notes), a step beyond the stable RK4 step
             and a state that is not finite after the step.
         """
         h = step_size(dt)
@@ -534,7 +534,7 @@ class ShipModel:
         Raises
         ------
         TypeError, ValueError
-            For bad arguments (class docstring, "Checks"), a policy output that is not a finite
+            For bad arguments (class docstring, Notes), a policy output that is not a finite
             ``(nu,)`` input, a step beyond the stable RK4 step and a state that becomes
             non-finite (naming the time).
         """
