@@ -31,7 +31,7 @@ from shipgym.sysid.report import (
     format_benchmark,
     plot_benchmark,
     relative_link,
-    update_readme,
+    update_block,
     write_json,
 )
 
@@ -82,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
             f"![sysid speed]({relative_link(png_path, page)})"
         )
         try:
-            changed = update_readme(page, block, "bench_sysid")
+            changed = update_block(page, block, "bench_sysid")
         except ValueError as exc:
             print(f"page not updated: {exc}", file=sys.stderr)
         else:

@@ -20,7 +20,7 @@ from shipgym.benchmark.report import PAGE, PAGE_MARKER, render_markdown, robustn
 from shipgym.benchmark.runner import run_benchmark
 from shipgym.cli import main as shipgym
 from shipgym.envs import ENV_IDS
-from shipgym.sysid.report import relative_link, update_readme
+from shipgym.sysid.report import relative_link, update_block
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The Gunnerus envs whose agents were trained on seed 001's parameters.
@@ -30,7 +30,7 @@ SEED001_ENVS = tuple(e for e in ENV_IDS if e.startswith("shipgym/RVG") and e.end
 def main(argv: list[str]) -> int:
     out = ROOT / "docs" / "benchmark"
     code = shipgym(["benchmark", "--out", str(out), *argv])
-    if code:
+    if code or {"-h", "--help"} & set(argv):
         return code
     entries = json.loads((out / "benchmark.json").read_text())
     reverse = run_benchmark(
@@ -46,7 +46,7 @@ def main(argv: list[str]) -> int:
         "on seed 001's parameters, on the sea-trial ship (same seeds):\n\n"
         + "\n".join(robustness_table(reverse.to_list()))
     )
-    update_readme(page, block, PAGE_MARKER)
+    update_block(page, block, PAGE_MARKER)
     print(f"wrote the block {PAGE_MARKER!r} of {PAGE}")
     return 0
 

@@ -51,7 +51,7 @@ from shipgym.sysid.report import (
     render_document,
     render_markdown,
     render_table,
-    update_readme,
+    update_block,
     write_json,
 )
 
@@ -197,7 +197,7 @@ def _write(
         page = Path(args.page)
         plot = relative_link(out / "identification.png", page)
         block = render_markdown(rows) + f"\n\n![heading error before/after]({plot})"
-        changed = update_readme(page, block)
+        changed = update_block(page, block)
         written.append(page if changed else Path(f"{page} (unchanged)"))
     failed = [r for r in rows if r["status"] != "ok"]
     print(

@@ -56,7 +56,7 @@ from shipgym.sysid.families.rvg import (
     measured_states,
     simulate_orders,
 )
-from shipgym.sysid.report import relative_link, update_readme
+from shipgym.sysid.report import relative_link, update_block
 
 REPO = Path(__file__).resolve().parents[1]
 _LOOP_CHANNELS = (("psi", "heading [deg]", math.degrees), ("r", "yaw rate [deg/s]", math.degrees),
@@ -268,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
         + "\n"
     )
     if not args.no_page:
-        update_readme(args.page, with_figures(Path(args.page)), "gunnerus")
+        update_block(args.page, with_figures(Path(args.page)), "gunnerus")
     print(with_figures(doc_path))
     print("\nwhole-record ship parameters (SEA_TRIALS_VALUES):")
     for k, v in values.items():

@@ -70,7 +70,7 @@ from shipgym.sysid import identify
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import FAMILIES, actual_rudder
 from shipgym.sysid.generator import MMG_EFFECTS, MMG_NOISE, generate_mmg_runs
-from shipgym.sysid.report import replace_between_markers, update_readme, write_json
+from shipgym.sysid.report import replace_between_markers, update_block, write_json
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_MODEL = "vmm:auto"
@@ -450,7 +450,7 @@ def main(argv: list[str] | None = None) -> int:
     write_json(doc, out / f"{name}.json")
     plot(doc, out / f"{name}.png")
     if not args.no_page:
-        update_readme(Path(args.page), render(doc), name)
+        update_block(Path(args.page), render(doc), name)
     _say(f"wrote {out / name}.json and .png in {doc['runtime_s']:.0f} s")
     return 0
 

@@ -57,7 +57,7 @@ from shipgym.models import Nomoto1Params, make_model
 from shipgym.sysid import identify, load
 from shipgym.sysid.families import vmm as fv
 from shipgym.sysid.fit import replay
-from shipgym.sysid.report import update_readme, write_json
+from shipgym.sysid.report import update_block, write_json
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from kvlcc2_simman import _trial
@@ -375,7 +375,7 @@ def main(argv: list[str] | None = None) -> int:
     write_json(doc, out / "kvlcc2_identify.json")
     plot(doc, out / "kvlcc2_identify.png")
     if not args.no_page:
-        update_readme(Path(args.page), render(doc), "kvlcc2_identify")
+        update_block(Path(args.page), render(doc), "kvlcc2_identify")
     _say(f"wrote {out / 'kvlcc2_identify.json'} and .png in {time.perf_counter() - t0:.0f} s")
     return 0
 

@@ -39,7 +39,7 @@ from shipgym.datasets import measured_root
 from shipgym.models import MMGParams, make_model
 from shipgym.models.mmg import KVLCC2_SCALE
 from shipgym.sysid import load
-from shipgym.sysid.report import relative_link, update_readme, write_json
+from shipgym.sysid.report import relative_link, update_block, write_json
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
@@ -120,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     print(md)
     if not args.no_page:
         figure = relative_link(out / "kvlcc2_simman.png", args.page)
-        update_readme(args.page, f"{md}\n\n![KVLCC2 against SIMMAN]({figure})", "kvlcc2_simman")
+        update_block(args.page, f"{md}\n\n![KVLCC2 against SIMMAN]({figure})", "kvlcc2_simman")
     return 0
 
 

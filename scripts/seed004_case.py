@@ -27,7 +27,7 @@ from shipgym.benchmark.seed004 import (
     run_seed004,
     tune_seed004,
 )
-from shipgym.sysid.report import relative_link, update_readme, write_json
+from shipgym.sysid.report import relative_link, update_block, write_json
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_page:
         figure = relative_link(out / "seed004.png", args.page)
         block = "\n".join([*lines, "", f"![seed 004's case]({figure})"])
-        update_readme(Path(args.page), block, "seed004")
+        update_block(Path(args.page), block, "seed004")
     print("\n".join(lines))
     return 0
 

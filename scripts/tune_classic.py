@@ -86,7 +86,7 @@ def plot_tuning(records: list[dict[str, Any]], path: Path) -> Path:
 def main(argv: list[str] | None = None) -> int:
     from shipgym.benchmark.tuning import TUNED_DIR, TUNING_EPISODES, load_tuned, tune, write_tuned
     from shipgym.envs import CURRENT_ENV_IDS
-    from shipgym.sysid.report import update_readme
+    from shipgym.sysid.report import update_block
 
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--only", default=None, help="tune only envs whose id contains TEXT")
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_report:
         records = [load_tuned(e, args.out) for e in CURRENT_ENV_IDS]
         print(f"wrote {plot_tuning(records, ROOT / 'docs' / 'tuning.png')}")
-        update_readme(PAGE, tuning_table(records), PAGE_MARKER)
+        update_block(PAGE, tuning_table(records), PAGE_MARKER)
         print(f"updated {PAGE.relative_to(ROOT)}")
     return 0
 

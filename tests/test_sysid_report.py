@@ -26,7 +26,7 @@ from shipgym.sysid.report import (
     render_markdown,
     render_table,
     replace_between_markers,
-    update_readme,
+    update_block,
     write_json,
 )
 
@@ -255,13 +255,13 @@ def test_replace_between_markers_is_idempotent_and_strict(tmp_path: Path) -> Non
 
     readme = tmp_path / "README.md"
     readme.write_text(text)
-    assert update_readme(readme, "new") is True
-    assert update_readme(readme, "new") is False
+    assert update_block(readme, "new") is True
+    assert update_block(readme, "new") is False
     assert readme.read_text().count("new") == 1 and "old table" not in readme.read_text()
     bare = tmp_path / "BARE.md"
     bare.write_text("# nothing\n")
     with pytest.raises(ValueError, match=r"BARE\.md: expected exactly one"):
-        update_readme(bare, "new")
+        update_block(bare, "new")
     assert bare.read_text() == "# nothing\n"
 
 

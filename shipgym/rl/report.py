@@ -113,7 +113,7 @@ def plot_learning_curves(
 def write_training_report(agent_dir: str | Path, root: str | Path) -> list[Path]:
     """Write ``docs/training.json``, ``docs/training.png`` and the block of
     ``docs/guide/training.md`` under ``root`` (the repository)."""
-    from shipgym.sysid.report import relative_link, update_readme
+    from shipgym.sysid.report import relative_link, update_block
 
     rows = training_rows(agent_dir)
     if not rows:
@@ -146,5 +146,5 @@ def write_training_report(agent_dir: str | Path, root: str | Path) -> list[Path]
     )
     page = docs / "guide" / "training.md"
     block += f"\n\n![learning curves]({relative_link(png, page)})"
-    update_readme(page, block, PAGE_MARKER)
+    update_block(page, block, PAGE_MARKER)
     return [json_path, png, page]

@@ -11,7 +11,7 @@
   parameters, held-out errors, the Gunnerus seed-001 / calibrated / with-effects comparison);
   :func:`plot_summary` draws the heading errors before and after, :func:`plot_record` the
   per-record figure (:func:`shipgym.sysid.plots.plot_identification`), and
-  :func:`update_readme` replaces a documentation page's block between ``<!-- identification -->``
+  :func:`update_block` replaces a documentation page's block between ``<!-- identification -->``
   markers (:func:`relative_link` links a page to a figure beside it).
   The script is ``scripts/identify_all.py``.
 * The speed of the loop (a first-order output-error fit of 10 000 samples, the whole loop on a
@@ -54,7 +54,7 @@ __all__ = [
     "BENCH_GOALS",
     "DEFAULT_MODELS",
     "FIGURES",
-    "README_MARKER",
+    "PAGE_MARKER",
     "benchmark_sysid",
     "format_benchmark",
     "identify_all",
@@ -70,7 +70,7 @@ __all__ = [
     "render_table",
     "replace_between_markers",
     "rvg_available",
-    "update_readme",
+    "update_block",
     "write_json",
 ]
 
@@ -86,7 +86,7 @@ FIGURES: dict[str, tuple[str, str]] = {
 }
 """Per-record figures of the report: source -> (model, file name in the output folder)."""
 
-README_MARKER = "identification"
+PAGE_MARKER = "identification"
 """Name of the block of ``docs/results/identification.md``: ``<!-- identification -->`` ...
 ``<!-- /identification -->``."""
 
@@ -778,7 +778,7 @@ def relative_link(target: str | Path, page: str | Path) -> str:
     return Path(os.path.relpath(Path(target), Path(page).parent)).as_posix()
 
 
-def update_readme(path: str | Path, content: str, name: str = README_MARKER) -> bool:
+def update_block(path: str | Path, content: str, name: str = PAGE_MARKER) -> bool:
     """Rewrite the ``name`` block of the Markdown page (the README or a documentation page) at
     ``path``; True if the file changed.
 
