@@ -73,6 +73,12 @@ def _simulate_turning(args: argparse.Namespace) -> _Trial:
         f"{res.steady_speed:.2f} m/s = {100 * res.speed_ratio:.1f} % of approach "
         f"(speed loss {loss:.1f} %)"
     )
+    if args.wind is not None:
+        print(
+            f"  drift over the steady turn {math.hypot(*res.drift):.1f} m ("
+            f"{res.drift_speed:.3f} m/s toward {math.degrees(res.drift_direction) % 360:.0f} deg)"
+            " in the wind: the trial correction removes it"
+        )
     rows = mv.imo_rows(res.particulars, turning=[res])
     return res.to_dict(), lambda out: mv.plot_turning_circle(res, out), rows
 
@@ -150,6 +156,41 @@ _SIMULATE: dict[str, Callable[[argparse.Namespace], _Trial]] = {
 }
 
 
+def wind_option(text: str) -> tuple[float, float]:
+    """``--wind SPEED,DIR``: true wind speed [m/s] and the direction it comes from [deg,
+    clockwise from north]; returned in SI units and radians."""
+    import math
+
+    parts = text.split(",")
+    try:
+        speed, direction = (float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"must be SPEED,DIR (m/s and deg the wind comes from), got {text!r}"
+        ) from None
+    if not (math.isfinite(speed) and 0.0 <= speed <= 80.0 and math.isfinite(direction)):
+        raise argparse.ArgumentTypeError(
+            f"speed must be in [0, 80] m/s and the direction finite, got {text!r}"
+        )
+    return speed, math.radians(direction)
+
+
+def _in_wind(ship: Any, model: str, speed: float, direction: float) -> Any:
+    """``ship`` in a constant true wind; the models with wind loads so far: ``kvlcc2``."""
+    import dataclasses
+
+    from shipgym.models import make_model
+
+    if model != "kvlcc2":
+        raise ValueError(
+            f"--wind: wind loads are modelled for kvlcc2 (Blendermann 1994), not for {model!r}"
+        )
+    params = make_model("kvlcc2").params
+    return make_model(
+        "kvlcc2", dataclasses.replace(params, wind_speed=speed, wind_direction=direction)
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     import json
 
@@ -195,6 +236,8 @@ def run(args: argparse.Namespace) -> int:
         )
     else:
         args.ship = args.model
+    if args.wind is not None:
+        args.ship = _in_wind(args.ship, args.model, *args.wind)
     params = f" --params {args.params}" if args.params else ""
     print(f"shipgym simulate {kind} --model {args.model}{params} ...", file=sys.stderr, flush=True)
     payload, draw, rows = _SIMULATE[kind](args)
@@ -266,6 +309,14 @@ def build(sub: Any) -> None:
         f"{NEWEST_RVG_PARAMETERS}, the Gunnerus identified from its sea trials; seed001 is the "
         "unvalidated seed model); for vmm the model file of a fit (shipgym identify --model "
         "vmm:<term set> --json FIT.json)",
+    )
+    p.add_argument(
+        "--wind",
+        type=wind_option,
+        default=None,
+        metavar="SPEED,DIR",
+        help="a constant true wind: speed [m/s] and the direction it comes from [deg, clockwise "
+        "from north], at the model's scale; the turning circle reports its drift (kvlcc2)",
     )
     p.add_argument(
         "--angle-deg",

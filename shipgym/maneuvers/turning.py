@@ -81,6 +81,14 @@ class TurningResult:
         (``|r - r_steady|`` < 2 % from then on) [s] (seed 002 Table 1).
     steady : bool
         Yaw rate and speed settled within the longest hold.
+    drift : tuple of float
+        Displacement (north, east) [m] of the ship over the fitted full steady turn: from a
+        heading to the same heading one turn later. Zero in calm water; in a current or wind it
+        is the drift that the classic trial correction removes from a turning circle (ITTC
+        Recommended Procedure 7.5-04-01-01.2, the drift over one loop).
+    drift_speed, drift_direction : float
+        That drift over the turn's duration [m/s] and the direction it goes toward [rad],
+        clockwise from north (NaN without drift).
     """
 
     model: str
@@ -106,6 +114,9 @@ class TurningResult:
     steady_time: float
     steady: bool
     dt: float
+    drift: tuple[float, float] = (0.0, 0.0)
+    drift_speed: float = 0.0
+    drift_direction: float = math.nan
 
     def to_dict(self, include_series: bool = True) -> dict[str, Any]:
         """Metrics (and time series) for JSON; degrees in ``*_deg`` keys."""
@@ -137,6 +148,9 @@ class TurningResult:
             "rudder_at_order_time_s": json_num(self.rudder_time),
             "steady_time_s": json_num(self.steady_time),
             "steady": self.steady,
+            "drift_m": [json_num(self.drift[0]), json_num(self.drift[1])],
+            "drift_speed_m_s": json_num(self.drift_speed),
+            "drift_direction_deg": json_deg(self.drift_direction),
             "speed_vs_heading_change": {
                 "heading_change_deg": [json_deg(h) for h in self.heading_changes],
                 "speed_m_s": [json_num(v) for v in self.speeds],
@@ -209,6 +223,15 @@ def turning_circle(
     end = crossing(h, h_start + 2 * math.pi)
     i_e = end[0] if end is not None else len(h) - 1
     cx, cy, radius = _fit_circle(series.x[i_s : i_e + 1], series.y[i_s : i_e + 1])
+    # from the heading at the start of the steady turn to the same heading one turn later
+    x_e, y_e, t_e = (
+        (series.x[i_e], series.y[i_e], series.time[i_e])
+        if end is None
+        else (value_at(series.x, end), value_at(series.y, end), value_at(series.time, end))
+    )
+    drift = (float(x_e - series.x[i_s]), float(y_e - series.y[i_s]))
+    drift_speed = math.hypot(*drift) / float(t_e - series.time[i_s])
+    drift_direction = math.atan2(drift[1], drift[0]) if drift_speed > 0.0 else math.nan
     r_ss = float(np.mean(series.r[i_s : i_e + 1]))
     v_ss = float(np.mean(series.speed[i_s : i_e + 1]))
     changes = np.radians(np.arange(10.0, 181.0, 10.0))
@@ -245,6 +268,9 @@ def turning_circle(
         steady_time=t_steady3,
         steady=steady,
         dt=rig.dt,
+        drift=drift,
+        drift_speed=drift_speed,
+        drift_direction=drift_direction,
     )
 
 
