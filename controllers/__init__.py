@@ -51,6 +51,7 @@ from controllers.speed import (
     quadratic_drag_feedforward,
 )
 from controllers.target import ConstantBearingGuidance, course_and_speed
+from controllers.wave_filter import WaveFilter
 
 __all__ = [
     "BOLLARD_THRUST",
@@ -68,6 +69,7 @@ __all__ = [
     "PodCommand",
     "SpeedAutopilot",
     "SplinePath",
+    "WaveFilter",
     "WaypointPath",
     "allocate_force_moment",
     "azimuth_to_action",
