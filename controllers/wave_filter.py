@@ -47,19 +47,12 @@ import numpy as np
 import scipy.linalg
 from numpy.typing import ArrayLike
 
-from controllers._angles import ssa_array
+from controllers._angles import finite, positive, ssa_array
 
 __all__ = ["WaveFilter"]
 
 #: Relative damping of the linear wave response model (Fossen 2021, section 10.2.3).
 WAVE_DAMPING = 0.1
-
-
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"WaveFilter: {name} must be a finite number > 0, got {value!r}")
-    return value
 
 
 class WaveFilter:
@@ -104,14 +97,14 @@ class WaveFilter:
         bias_noise: float = 1e-4,
         wave_damping: float = WAVE_DAMPING,
     ) -> None:
-        K = float(K)
-        if not (math.isfinite(K) and K != 0.0):
-            raise ValueError(f"WaveFilter: K must be a finite, non-zero number, got {K!r}")
-        T = _positive("T", T)
-        self.dt = _positive("dt", dt)
-        w0 = _positive("peak_frequency", peak_frequency)
-        lam = _positive("wave_damping", wave_damping)
-        sigma = _positive("wave_heading_std", wave_heading_std)
+        K = finite("K", K)
+        if K == 0.0:
+            raise ValueError("K must be a finite, non-zero number, got 0.0")
+        T = positive("T", T)
+        self.dt = positive("dt", dt)
+        w0 = positive("peak_frequency", peak_frequency)
+        lam = positive("wave_damping", wave_damping)
+        sigma = positive("wave_heading_std", wave_heading_std)
         k_w = sigma * math.sqrt(4.0 * lam * w0)
         a = np.array(
             [
@@ -123,8 +116,8 @@ class WaveFilter:
             ]
         )
         b = np.array([0.0, 0.0, 0.0, K / T, 0.0])
-        g = np.diag([0.0, k_w, 0.0, abs(K) / T * _positive("rudder_noise", rudder_noise), 0.0])
-        g[4, 4] = _positive("bias_noise", bias_noise)
+        g = np.diag([0.0, k_w, 0.0, abs(K) / T * positive("rudder_noise", rudder_noise), 0.0])
+        g[4, 4] = positive("bias_noise", bias_noise)
         n = 5
         # Van Loan: the discrete transition and process-noise covariance of one step
         van = np.zeros((2 * n, 2 * n))
@@ -140,7 +133,7 @@ class WaveFilter:
         hold[:n, n] = b
         gamma = scipy.linalg.expm(hold * self.dt)[:n, n]
         c = np.array([[0.0, 1.0, 1.0, 0.0, 0.0]])
-        r = np.array([[_positive("compass_std", compass_std) ** 2]])
+        r = np.array([[positive("compass_std", compass_std) ** 2]])
         p = scipy.linalg.solve_discrete_are(phi.T, c.T, 0.5 * (q + q.T), r)
         self.gain = (p @ c.T / (c @ p @ c.T + r)[0, 0])[:, 0]
         self.transition = phi
