@@ -5,8 +5,11 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
+
+from shipgym._io import write_atomically
 
 PROG = "shipgym"
 #: A command's handler: parsed arguments -> exit code.
@@ -150,3 +153,13 @@ def model_name(text: str) -> str:
     raise argparse.ArgumentTypeError(
         f"must be one of {', '.join(MODEL_NAMES)} or a model file FIT.json, got {text!r}"
     )
+
+
+def write_outputs(
+    outputs: Sequence[tuple[Path, Callable[[Path], Any]]], stream: Any = None
+) -> None:
+    """Write every output at once (:func:`shipgym._io.write_atomically`: all or none), then
+    print a ``wrote PATH`` line for each (to ``stream``, stdout by default)."""
+    write_atomically(outputs)
+    for target, _ in outputs:
+        print(f"wrote {target}", file=stream or sys.stdout)

@@ -8,8 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
-from shipgym.cli._common import int_in, output_path
+from shipgym.cli._common import int_in, output_path, write_outputs
 
 
 def run(args: argparse.Namespace) -> int:
@@ -36,9 +35,7 @@ def run(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: write_json(report, p)))
     if plot_path is not None:
         outputs.append((plot_path, lambda p: plot_ratios(report, p)))
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}")
+    write_outputs(outputs)
     return 0
 
 

@@ -7,7 +7,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
 from shipgym.cli._common import (
     MAX_EPISODES,
     MAX_SEED,
@@ -15,6 +14,7 @@ from shipgym.cli._common import (
     output_dir,
     output_path,
     progress_line,
+    write_outputs,
 )
 from shipgym.cli._ray import add_ray_flags, campaign_failed, ray_options
 
@@ -132,9 +132,7 @@ def run(args: argparse.Namespace) -> int:
                 lambda p, env_id=env_id: plot_benchmark_trajectories(result, env_id, p),
             )
         )
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}")
+    write_outputs(outputs)
     if args.throughput:
         rows = ppo_throughput(result.envs, timesteps=args.throughput_steps, progress=progress)
         print(throughput_table(rows))
@@ -142,9 +140,7 @@ def run(args: argparse.Namespace) -> int:
             (out / "throughput.json", lambda p: p.write_text(json.dumps(rows, indent=2) + "\n")),
             (plots / "throughput.png", lambda p: plot_throughput(rows, p)),
         ]
-        write_atomically(outputs)
-        for target, _ in outputs:
-            print(f"wrote {target}")
+        write_outputs(outputs)
     return 0
 
 

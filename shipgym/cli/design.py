@@ -8,8 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
-from shipgym.cli._common import PROG, float_in, output_path
+from shipgym.cli._common import PROG, float_in, output_path, write_outputs
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,9 +61,7 @@ def run(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: p.write_text(text, encoding="utf-8")))
     if plot_path is not None:
         outputs.append((plot_path, lambda p: plot_heading_design(design, p)))
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}")
+    write_outputs(outputs)
     if json_path is not None:
         print(
             f"run it on the identified ship: {PROG} evaluate --env shipgym/NomotoHeading-v0 "

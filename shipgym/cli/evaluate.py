@@ -8,7 +8,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
 from shipgym.cli._common import (
     MAX_EPISODES,
     MAX_SEED,
@@ -18,6 +17,7 @@ from shipgym.cli._common import (
     model_name,
     output_dir,
     output_path,
+    write_outputs,
 )
 from shipgym.cli._ray import add_ray_flags, campaign_failed, ray_options
 
@@ -114,9 +114,7 @@ def run(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: p.write_text(json.dumps(summary, indent=2) + "\n")))
     if plot_dir is not None:
         outputs += episode_figures(result, plot_dir, max_episodes=args.episodes)
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}")
+    write_outputs(outputs)
     return 0
 
 

@@ -9,8 +9,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
-from shipgym.cli._common import finite_float, float_in, int_in, output_path
+from shipgym.cli._common import finite_float, float_in, int_in, output_path, write_outputs
 
 
 def _window(text: str) -> float | str | None:
@@ -388,9 +387,7 @@ def run(args: argparse.Namespace) -> int:
         from shipgym.sysid.plots import plot_identification
 
         outputs.append((plot_path, lambda p: plot_identification(result, p)))
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}", file=report)
+    write_outputs(outputs, report)
     if args.json == "-":
         sys.stdout.write(text)
         sys.stdout.flush()

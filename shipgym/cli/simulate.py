@@ -10,7 +10,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from shipgym._io import write_atomically
 from shipgym.cli._common import (
     finite_float,
     float_in,
@@ -18,6 +17,7 @@ from shipgym.cli._common import (
     model_name,
     output_path,
     progress_line,
+    write_outputs,
 )
 
 # Each trial runner prints its metrics and returns (JSON payload, figure writer, IMO rows).
@@ -265,9 +265,7 @@ def run(args: argparse.Namespace) -> int:
         outputs.append((json_path, lambda p: p.write_text(text)))
     if plot_path is not None:
         outputs.append((plot_path, draw))
-    write_atomically(outputs)
-    for target, _ in outputs:
-        print(f"wrote {target}")
+    write_outputs(outputs)
     return 0
 
 
