@@ -56,7 +56,7 @@ def _attainable_step(
     dmax = p[0]
     XB = np.empty((NX, BLOCK))
     UB = np.empty((2, BLOCK))
-    CB = np.empty((2, BLOCK))
+    CB = np.zeros((integrate.NC, BLOCK))  # current; no seaway load
     W = np.empty((3, NX, BLOCK))
     for s in range(0, n, BLOCK):
         for b in range(BLOCK):

@@ -140,7 +140,8 @@ def main() -> None:
     h = 0.1
     # the two agree before anything is timed
     a = x.copy()
-    XT, UT, CT = np.ascontiguousarray(x.T), np.ascontiguousarray(u.T), np.ascontiguousarray(c.T)
+    XT, UT = np.ascontiguousarray(x.T), np.ascontiguousarray(u.T)
+    CT = integrate.disturbance_block(c)
     for _ in range(100):
         integrate.rk4_step_kernel(integrate.RVG3DOF, a, u, p, c, h)
         _reference_step(XT, UT, CT, q, h)

@@ -82,7 +82,7 @@ def test_a_parameter_table_steps_each_ship_as_alone_with_its_own_vector(name: st
     else:
         X[3] = rng.uniform(2.0, 8.0, n)
         U = rng.normal(size=(nu, n)) * 0.2
-    C = rng.uniform(-0.5, 0.5, (2, n))
+    C = I.disturbance_block(rng.uniform(-0.5, 0.5, (2, n)).T)  # current, no seaway load
     P = _readonly(np.column_stack(ps))
     together = X.copy()
     W = np.empty((3, nx, n))

@@ -216,19 +216,21 @@ def test_heading_kernel_runs_an_unlisted_shape_as_a_listed_one() -> None:
         np.array(v) if isinstance(v, np.ndarray) else v for v in task._args(True, np.arange(n))
     ]
     other = [np.array(v) if isinstance(v, np.ndarray) else v for v in listed]
-    # args: ..., obs_idx 12, ..., obs 16, ..., obs_lo 20, obs_hi 21
-    other[12] = listed[12][:1].copy()
-    other[16] = listed[16][:, :2].copy()
-    other[20], other[21] = listed[20][:2].copy(), listed[21][:2].copy()
+    # args: ..., x 3, ..., xm 8 (x itself in calm water), a 10, ..., obs_idx 14, ..., steps 17,
+    # obs 18, rew 19, term 20, reason 21, obs_lo 22, obs_hi 23
+    listed[8], other[8] = listed[3], other[3]
+    other[14] = listed[14][:1].copy()
+    other[18] = listed[18][:, :2].copy()
+    other[22], other[23] = listed[22][:2].copy(), listed[23][:2].copy()
     rng = np.random.default_rng(3)
     heading = kernels.KERNELS["heading"]
     for step in range(12):
         a = rng.uniform(-1.5, 1.5, (n, 1))
-        listed[8][:], other[8][:] = a, a
+        listed[10][:], other[10][:] = a, a
         if step == 4:
             listed[3][7, 2] = other[3][7, 2] = np.nan  # a blow-up in one row
         assert heading(*listed) == heading(*other) == -1
-        for k, name in ((3, "x"), (15, "steps"), (17, "rew"), (18, "term"), (19, "reason")):
+        for k, name in ((3, "x"), (17, "steps"), (19, "rew"), (20, "term"), (21, "reason")):
             np.testing.assert_array_equal(other[k], listed[k], err_msg=f"step {step}: {name}")
-        np.testing.assert_array_equal(other[16], listed[16][:, :2], err_msg=f"step {step}: obs")
-    assert listed[19][7] == kernels.BLOW_UP and np.ptp(listed[3][:, 4]) > 0.0
+        np.testing.assert_array_equal(other[18], listed[18][:, :2], err_msg=f"step {step}: obs")
+    assert listed[21][7] == kernels.BLOW_UP and np.ptp(listed[3][:, 4]) > 0.0

@@ -51,6 +51,7 @@ from shipgym.models.integrate import (
     scatter_rows,
 )
 from shipgym.models.rvg import P_TBOLL
+from shipgym.models.seaway import seaway_block
 from shipgym.models.vmath import sincos
 
 RUNNING, BLOW_UP, SUCCESS, FAILURE = 0, 1, 2, 3
@@ -183,6 +184,16 @@ def _row_work(obs_dim):
     return np.empty(BLOCK, dtype=np.bool_), np.empty((BLOCK, obs_dim)), np.empty(BLOCK)
 
 
+@row_kernel
+def _seaway(sw, rows, start, n, x, c, xm, dt, advance):
+    """The seaway of the block's rows after their step (or at a reset):
+    :func:`~shipgym.models.seaway.seaway_block` sets their measured states ``xm`` and their
+    load of the next step; nothing without a seaway (``sw[0]`` False, ``xm`` is ``x``)."""
+    if sw[0]:
+        seaway_block(rows, start, n, x, c, xm, sw[1], sw[2], sw[3], sw[4], sw[5], sw[6], sw[7],
+                     dt, advance)  # fmt: skip
+
+
 def _heading(
     advance,
     rows,
@@ -191,6 +202,8 @@ def _heading(
     u,
     p,
     c,
+    sw,
+    xm,
     dt,
     a,
     u0,
@@ -250,6 +263,7 @@ def _heading(
                 scatter_rows(work[0], rows, start, m, x, GUNNERUS[0])
             else:
                 scatter_rows(work[0], rows, start, m, x, dims[0])
+        _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         if family == 0:
             _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason,
                          FIRST_ORDER[0], FIRST_ORDER[2])  # fmt: skip
@@ -264,10 +278,13 @@ def _heading(
         for b in range(m):
             if ok[b]:
                 i = rows[start + b]
-                e = ssa_scalar(schedule[i, min(steps[i] // hold_steps, last)] - x[i, ipsi])
+                setpoint = schedule[i, min(steps[i] // hold_steps, last)]
+                e = ssa_scalar(setpoint - xm[i, ipsi])  # as measured
                 new[b, 0] = e
                 for k in range(obs_idx.shape[0]):
-                    new[b, 1 + k] = x[i, obs_idx[k]]
+                    new[b, 1 + k] = xm[i, obs_idx[k]]
+                if sw[0]:  # the reward is the low-frequency heading's
+                    e = ssa_scalar(setpoint - x[i, ipsi])
                 rew[i] = -abs(e) / math.pi - 0.05 * cost[b]
         if family == 0:
             _finish_block(obs, rows, start, m, ok, obs_lo, obs_hi, new, rew, term, reason,
@@ -291,6 +308,8 @@ def _speed(
     u,
     p,
     c,
+    sw,
+    xm,
     dt,
     a,
     u0,
@@ -328,6 +347,7 @@ def _speed(
             _advance_block(
                 full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
             )
+        _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if ok[b]:
@@ -368,6 +388,8 @@ def _path(
     u,
     p,
     c,
+    sw,
+    xm,
     dt,
     a,
     u0,
@@ -427,6 +449,7 @@ def _path(
             _advance_block(
                 full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
             )
+        _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if not ok[b]:
@@ -469,13 +492,25 @@ def _path(
                 reason[i] = FAILURE
                 bonus = -20.0
             chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
-            new[b, 0] = e
-            new[b, 1] = chi_err
-            new[b, 2] = s_left
+            e_m, s_m, chi_m = e, s_left, chi_err  # as measured
+            if sw[0]:
+                e_m, s_m = path_geometry(
+                    xm[i, 0],
+                    xm[i, 1],
+                    tangent[i, k, 0],
+                    tangent[i, k, 1],
+                    tangent[i, k, 2],
+                    tangent[i, k, 3],
+                    leg_length[i, k],
+                )
+                chi_m = ssa_scalar(leg_angle[i, k] - xm[i, 2])
+            new[b, 0] = e_m
+            new[b, 1] = chi_m
+            new[b, 2] = s_m
             new[b, 3] = turn[i, k]
             new[b, 4] = x[i, 3]
             new[b, 5] = x[i, 4]
-            new[b, 6] = x[i, 5]
+            new[b, 6] = xm[i, 5]
             new[b, 7] = x[i, 8]
             new[b, 8] = x[i, 6] / tb
             rew[i] = (
@@ -497,6 +532,8 @@ def _target(
     u,
     p,
     c,
+    sw,
+    xm,
     dt,
     a,
     u0,
@@ -540,28 +577,31 @@ def _target(
                 i = rows[start + b]
                 target[i, 0] += target_vel[i, 0] * dt
                 target[i, 1] += target_vel[i, 1] * dt
+        _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
             if not ok[b]:
                 continue
             i = rows[start + b]
             sn, cs = sincos(x[i, 2])
-            dn = target[i, 0] - x[i, 0]
-            de = target[i, 1] - x[i, 1]
             vn = cs * x[i, 3] - sn * x[i, 4]  # ship velocity over ground, NED
             ve = sn * x[i, 3] + cs * x[i, 4]
             rvn = target_vel[i, 0] - vn
             rve = target_vel[i, 1] - ve
-            d = math.hypot(dn, de)
+            d = math.hypot(target[i, 0] - x[i, 0], target[i, 1] - x[i, 1])
             err = d - distance[i]
+            # as measured: the position and heading with the wave-frequency motion
+            sn, cs = sincos(xm[i, 2])
+            dn = target[i, 0] - xm[i, 0]
+            de = target[i, 1] - xm[i, 1]
             new[b, 0] = cs * dn + sn * de
             new[b, 1] = -sn * dn + cs * de
             new[b, 2] = cs * rvn + sn * rve
             new[b, 3] = -sn * rvn + cs * rve
-            new[b, 4] = err
+            new[b, 4] = math.hypot(dn, de) - distance[i] if sw[0] else err
             new[b, 5] = x[i, 3]
             new[b, 6] = x[i, 4]
-            new[b, 7] = x[i, 5]
+            new[b, 7] = xm[i, 5]
             new[b, 8] = x[i, 8]
             new[b, 9] = x[i, 6] / tb
             rew[i] = 1.0 - min(abs(err) / 100.0, 2.0) - 0.05 * cost[b]

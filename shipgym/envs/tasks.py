@@ -43,14 +43,20 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.envs import kernels
+from shipgym.envs import seaway as seaway_options
+from shipgym.envs.seaway import SeawayArrays
 from shipgym.envs.streams import RowStreams
 from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
+from shipgym.models import seaway as sw
 from shipgym.models.angles import ssa
 from shipgym.models.delay import DelayLine
+from shipgym.models.integrate import NC
 from shipgym.models.model_file import is_model_file, load_model, model_info
 from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
 
-COMMON_OPTIONS = frozenset({"current_speed", "current_direction", "initial_state"})
+COMMON_OPTIONS = frozenset(
+    {"current_speed", "current_direction", "initial_state", "wind", "sea_state"}
+)
 _N_COMMON_DRAWS = 2
 #: Largest angle [rad] a reset option may give (heading, setpoint, current direction): 100 turns.
 MAX_ANGLE = 200.0 * math.pi
@@ -179,7 +185,13 @@ class Task:
         self.max_current_speed = float(max_current_speed)
         self.x = np.zeros((n, model.nx))
         self.u = np.zeros((n, model.nu))
-        self.c = np.zeros((n, 2))
+        self.c = np.zeros((n, NC))  # current north, east; the seaway's load
+        #: The measured states: ``x`` plus the wave-frequency motion; ``x`` itself in calm water.
+        self.xm = self.x
+        #: The seaway of the batch, made at the first reset with wind or waves.
+        self.seaway: SeawayArrays | None = None
+        self.default_wind: seaway_options.Wind | None = None
+        self.default_sea: seaway_options.Sea | None = None
         self.current = np.zeros((n, 2))  # speed [m/s], direction [rad]
         self.a = np.zeros((n, self.act_dim))
         self.obs = np.zeros((n, self.obs_dim))
@@ -292,6 +304,8 @@ class Task:
             self.u,
             m.p,
             self.c,
+            self._seaway_args(),
+            self.xm,
             self.dt,
             self.a,
             self.u0,
@@ -305,6 +319,51 @@ class Task:
             self.obs_low,
             self.obs_high,
         )
+
+    #: The ship of the seaway (wind and wave data), or None where they are not known.
+    seaway_ship: ClassVar[Callable[[], sw.SeawayShip] | None] = None
+
+    def _seaway_args(self) -> tuple[Any, ...]:
+        """The seaway argument of the kernel: the batch's, or an empty one in calm water."""
+        if self.seaway is not None:
+            return self.seaway.kernel_args()
+        empty = np.zeros((0, 0))
+        return (False, empty, empty, np.zeros(0, dtype=np.uint64), empty, np.zeros((0, 0, 0)),
+                np.zeros(0), 0)  # fmt: skip
+
+    def set_seaway(self, wind: Any = None, sea_state: Any = None) -> None:
+        """Set the wind and sea state of every episode (the env constructors' ``wind`` and
+        ``sea_state``; :mod:`shipgym.envs.seaway`); a reset's options override them.
+
+        Raises
+        ------
+        ValueError
+            For a bad value, or a seaway on a ship whose wind and wave data are not known.
+        """
+        wind_spec = seaway_options.wind_option(wind)
+        sea_spec = seaway_options.sea_option(sea_state)
+        if wind_spec is not None or sea_spec is not None:
+            self._require_seaway_ship()
+        self.default_wind, self.default_sea = wind_spec, sea_spec
+
+    def _require_seaway_ship(self) -> sw.SeawayShip:
+        if self.seaway_ship is None:
+            raise ValueError(
+                "options 'wind' and 'sea_state' need the ship's wind areas and hull: known "
+                "for the Mariner of the Nomoto family and the R/V Gunnerus, not for "
+                f"{self.model.name!r} identified from a record"
+            )
+        return self.seaway_ship()
+
+    def _start_seaway(self) -> SeawayArrays:
+        """The batch's seaway, made (and the measured states split from the states) at first."""
+        if self.seaway is None:
+            self.seaway = SeawayArrays(
+                self.n, self._require_seaway_ship(), self.dt, self.model.index("r")
+            )
+            self.xm = self.x.copy()
+            self._step_call = None  # the kernel's arguments change
+        return self.seaway
 
     def step(self, rows: np.ndarray | None = None) -> int:
         """Step every row, or only ``rows``, with the actions in ``self.a``.
@@ -370,12 +429,24 @@ class Task:
                 f"{sorted(COMMON_OPTIONS | self.task_options)}"
             )
         rows = np.asarray(rows, dtype=np.int64)
+        wind = (
+            seaway_options.wind_option(options["wind"]) if "wind" in options else self.default_wind
+        )
+        sea = (
+            seaway_options.sea_option(options["sea_state"])
+            if "sea_state" in options
+            else self.default_sea
+        )
+        at_sea = wind is not None or sea is not None
+        if at_sea:
+            self._require_seaway_ship()
+        n_draws = self.n_draws + (seaway_options.N_DRAWS if at_sea else 0)
         if isinstance(rngs, RowStreams):
-            draws = rngs.random(rows, self.n_draws)
+            draws = rngs.random(rows, n_draws)
         else:
-            draws = np.empty((rows.size, self.n_draws))
+            draws = np.empty((rows.size, n_draws))
             for k, rng in enumerate(rngs):
-                draws[k] = rng.random(self.n_draws)
+                draws[k] = rng.random(n_draws)
         speed = draws[:, 0] * self.max_current_speed
         direction = _uniform(draws[:, 1], -math.pi, math.pi)
         self._validate_task_options(options)  # every option, before anything is changed
@@ -383,7 +454,7 @@ class Task:
             speed[:] = float(options["current_speed"])
         if "current_direction" in options:
             direction[:] = float(options["current_direction"])
-        task_draws = draws[:, _N_COMMON_DRAWS:]
+        task_draws = draws[:, _N_COMMON_DRAWS : self.n_draws]
         states = self._initial_states(task_draws)
         if "initial_state" in options:
             self._apply_initial_state(options["initial_state"], states)
@@ -397,6 +468,11 @@ class Task:
         if self.delay is not None:
             self.delay.reset(rows)
         self._reset_task(rows, task_draws, options)
+        if at_sea or self.seaway is not None:
+            seaway = self._start_seaway()
+            sea_draws = draws[:, self.n_draws :] if at_sea else np.zeros((rows.size, 6))
+            seaway.set_rows(rows, wind, sea, sea_draws)
+            sw.start_rows(rows, self.x, self.c, seaway.sea, seaway.wf, seaway.rng, self.dt)
         self._kernel(rows.size)(*self._args(False, rows))
 
     def observe(self, states: np.ndarray) -> np.ndarray:
@@ -410,7 +486,9 @@ class Task:
         states = np.asarray(states, dtype=np.float64)
         if states.shape != self.x.shape:
             raise ValueError(f"states must have shape {self.x.shape}, got {states.shape}")
-        kept = [self.x, self.obs, self.rew, self.term, self.reason]
+        kept = [self.x, self.obs, self.rew, self.term, self.reason, self.c]
+        if self.seaway is not None:
+            kept += [self.xm, self.seaway.wf]
         kept += [a for a in self._kernel_args() if isinstance(a, np.ndarray)]
         saved = [a.copy() for a in kept]
         try:
@@ -470,6 +548,7 @@ class Task:
             "current_direction": direction,
             "termination_reason": kernels.REASONS[self.reason[i]],
             **self.metrics(i),
+            **(self.seaway.row_info(i) if self.seaway is not None else {}),
         }
 
     def batch_info(self, rows: slice | np.ndarray = slice(None)) -> dict[str, np.ndarray]:
@@ -496,6 +575,8 @@ class Task:
         for key, value in self.batch_metrics(rows).items():
             # a view of the task's arrays is copied; an array made for this call is new already
             info[key] = value if value.base is None else value.copy()
+        if self.seaway is not None:
+            info.update(self.seaway.info(rows))
         return info
 
 
@@ -595,6 +676,7 @@ class NomotoHeadingTask(HeadingTask):
     reward_bounds = (-1.05, 0.0)
     ship_length = 160.9  # [m], the Mariner class cargo ship
     ship_beam = 23.2  # [m]
+    seaway_ship = staticmethod(sw.mariner_seaway)
 
     def __init__(
         self,
@@ -610,6 +692,7 @@ class NomotoHeadingTask(HeadingTask):
             length = model_info(model).get("length_m")
             # an identified ship of unknown length: a small craft's, so the ranges are wide
             self.ship_length = float(length) if length else IDENTIFIED_SHIP_LENGTH
+            self.seaway_ship = None  # its wind areas and hull are not known
         super().__init__(n, ship, max_current_speed, setpoint_interval)
         gear, surge = self.model.gear, self.model.surge
         assert gear is not None and surge is not None
@@ -674,6 +757,7 @@ class RVGMixin:
 
     dt = 0.5
     ship_length = LPP
+    seaway_ship = staticmethod(sw.gunnerus_seaway)
     x: np.ndarray
     c: np.ndarray
     model: ShipModel

@@ -3,6 +3,13 @@
 ``rhs(model_id, x, u, p, c, out)`` evaluates the batched state derivative
 ``x' = f(x, u, p, c)`` for a batch of ships (``x`` of shape ``(n, nx)``, ``u`` of shape
 ``(n, nu)``, ``c`` the ``(n, 2)`` north/east current) with the model's one derivative.
+
+The blocks of the environment models carry :data:`NC` disturbance rows per ship (``C``): the
+north/east current and the external load of the seaway (:mod:`shipgym.models.seaway`), held
+over the step like the current: for the R/V Gunnerus the surge and sway forces [N] and the yaw
+moment [N m] about its origin, for the Nomoto family the equivalent rudder angle [rad] and the
+leeway [m/s] (seed 003 eq. 1's ``tau_wind + tau_wave``). A batch of rows with only the two
+current columns (every user but the environments) gathers into a block with a zero load.
 ``rk4_step`` advances the batch in place by one classic fourth-order Runge-Kutta step with
 the input and current held over the step (seed 001 eq. 2). Every user of a model, the
 environments, the manoeuvres and identification, integrates through their compiled kernels
@@ -84,6 +91,9 @@ _PARAMETER_COUNTS = (
     rvg.P_SIZE, mmg.P_SIZE, -1,
 )  # fmt: skip
 
+
+#: Disturbance rows of a block (``C``): current north, east; load X, Y, N (module docstring).
+NC = 5
 
 #: Ships per block of :func:`rk4_block` in the batch kernels (a block's work arrays stay in
 #: the first-level cache; a multiple of the SIMD width).
@@ -210,10 +220,19 @@ def full_block_rvg(model_id, X, U, p, C, h, W):
 
 @row_kernel
 def block_work(nx, nu, n):
-    """Work arrays of one block for a batch of ``n`` ships: states, inputs, current (ships as
-    columns) and the RK4 scratch of :func:`rk4_block`, ``min(n, BLOCK)`` ships wide."""
+    """Work arrays of one block for a batch of ``n`` ships: states, inputs, disturbances (ships
+    as columns; :data:`NC` rows) and the RK4 scratch of :func:`rk4_block`, ``min(n, BLOCK)``
+    ships wide."""
     m = max(min(n, BLOCK), 1)
-    return (np.empty((nx, m)), np.empty((nu, m)), np.empty((2, m)), np.empty((3, nx, m)))
+    return (np.empty((nx, m)), np.empty((nu, m)), np.empty((NC, m)), np.empty((3, nx, m)))
+
+
+def disturbance_block(current: np.ndarray) -> np.ndarray:
+    """The block of disturbances (:data:`NC` rows, ships as columns, C-contiguous) of ships with
+    the north/east currents ``current`` (``(n, 2)``) and no seaway load."""
+    block = np.zeros((NC, current.shape[0]))
+    block[:2] = current.T
+    return block
 
 
 @row_kernel
@@ -224,8 +243,8 @@ def _gather(x, u, c, rows, start, n, XB, UB, CB, nx, nu):
             XB[j, b] = x[i, j]
         for j in range(nu):
             UB[j, b] = u[i, j]
-        CB[0, b] = c[i, 0]
-        CB[1, b] = c[i, 1]
+        for j in range(NC):  # a batch with the current alone gets a zero load
+            CB[j, b] = c[i, j] if j < c.shape[1] else 0.0
 
 
 @row_kernel

@@ -264,7 +264,9 @@ def _actuators_and_kinematics(X, U, p, C, b):
     ``(x', y', psi', U', delta')``.
 
     The model functions here take a block of ships column by column (``X`` states x ships,
-    ``U`` inputs x ships, ``C`` north/east current x ships, ``K`` the derivative), as
+    ``U`` inputs x ships, ``C`` the disturbances x ships: current north and east, then the
+    seaway's equivalent rudder angle ``delta_w`` and leeway ``v_w`` (:mod:`shipgym.models.seaway`),
+    ``K`` the derivative), as
     :func:`shipgym.models.integrate.rk4_block` steps them; one ship is a block of one. ``p`` is
     the packed parameter vector shared by the block, or a table of them with a column per ship
     (:func:`shipgym.models._jit.param`).
@@ -277,9 +279,10 @@ def _actuators_and_kinematics(X, U, p, C, b):
     ddot = min(max((dc - X[IDELTA, b]) / param(p, P_TDELTA, b), -rate), rate)
     sn, cs = sincos(X[IPSI, b])
     speed = X[IU, b]
+    leeway = C[3, b]
     return (
-        speed * cs + C[0, b],
-        speed * sn + C[1, b],
+        speed * cs - leeway * sn + C[0, b],
+        speed * sn + leeway * cs + C[1, b],
         X[IR, b],
         (param(p, P_KU, b) * U[1, b] - speed) / param(p, P_TU, b),
         ddot,
@@ -301,7 +304,7 @@ def nomoto1_col(X, U, p, C, K, b):
     """First-order Nomoto derivative (seed 004 eq. 2) of ship ``b`` of a block."""
     xd, yd, psid, ud, ddot = _actuators_and_kinematics(X, U, p, C, b)
     gain, T = param(p, P_YAW, b), param(p, P_YAW + 1, b)
-    rd = (gain * X[IDELTA, b] - X[IR, b]) / T
+    rd = (gain * (X[IDELTA, b] + C[2, b]) - X[IR, b]) / T
     _store(K, b, xd, yd, psid, ud, ddot)
     K[IR, b] = rd
 
@@ -319,7 +322,7 @@ def norrbin_col(X, U, p, C, K, b):
     )
     r = X[IR, b]
     hn = n3 * r * r * r + n2 * r * abs(r) + n1 * r + n0
-    rd = (gain * X[IDELTA, b] - hn) / T
+    rd = (gain * (X[IDELTA, b] + C[2, b]) - hn) / T
     _store(K, b, xd, yd, psid, ud, ddot)
     K[IR, b] = rd
 
@@ -335,7 +338,7 @@ def nomoto2_col(X, U, p, C, K, b):
         param(p, P_YAW + 3, b),
     )
     rdot = X[IRDOT, b]
-    rdd = (gain * (X[IDELTA, b] + T3 * ddot) - (T1 + T2) * rdot - X[IR, b]) / (T1 * T2)
+    rdd = (gain * (X[IDELTA, b] + C[2, b] + T3 * ddot) - (T1 + T2) * rdot - X[IR, b]) / (T1 * T2)
     _store(K, b, xd, yd, psid, ud, ddot)
     K[IR, b] = rdot
     K[IRDOT, b] = rdd
@@ -360,7 +363,7 @@ def bech_col(X, U, p, C, K, b):
     r = X[IR, b]
     rdot = X[IRDOT, b]
     hb = b3 * r * r * r + b2 * r * abs(r) + b1 * r + b0
-    rdd = (gain * (X[IDELTA, b] + T3 * ddot) - (T1 + T2) * rdot - gain * hb) / (T1 * T2)
+    rdd = (gain * (X[IDELTA, b] + C[2, b] + T3 * ddot) - (T1 + T2) * rdot - gain * hb) / (T1 * T2)
     _store(K, b, xd, yd, psid, ud, ddot)
     K[IR, b] = rdot
     K[IRDOT, b] = rdd

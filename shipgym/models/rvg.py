@@ -567,7 +567,9 @@ def pod_thrusts(rpm, x, c, p):
 def rvg_col(X, U, p, C, K, b):
     """RVG 3-DOF derivative (seed 001 eq. 5-20) of ship ``b`` of a block, written into ``K``.
 
-    ``X`` (states x ships), ``U`` (inputs x ships), ``C`` (north/east current x ships) and ``K``
+    ``X`` (states x ships), ``U`` (inputs x ships), ``C`` (disturbances x ships: current north
+    and east, then the seaway's surge and sway force [N] and yaw moment [N m] about the origin,
+    :mod:`shipgym.models.seaway`) and ``K``
     hold a block of ships column by column (:func:`shipgym.models.integrate.rk4_block`); one
     ship is a block of one. ``p`` is :func:`pack_rvg`'s vector, shared by the block, or a table
     of such vectors with a column per ship (:func:`shipgym.models._jit.param`). The function is
@@ -604,9 +606,10 @@ def rvg_col(X, U, p, C, K, b):
     )
     t1 = th1 * param(p, P_HULL_T, b)  # thrust on the hull, (1 - t) T
     t2 = th2 * param(p, P_HULL_T, b)
-    fx = t1 * ca1 + t2 * ca2
-    fy = t1 * sa1 + t2 * sa2
-    fn = t1 * (-y1 * ca1 + x1 * sa1) + t2 * (-y2 * ca2 + x2 * sa2)
+    # the pods' forces plus the seaway's load (wind, wave drift; :mod:`shipgym.models.seaway`)
+    fx = t1 * ca1 + t2 * ca2 + C[2, b]
+    fy = t1 * sa1 + t2 * sa2 + C[3, b]
+    fn = t1 * (-y1 * ca1 + x1 * sa1) + t2 * (-y2 * ca2 + x2 * sa2) + C[4, b]
     # pod foil normal force from each pod's own inflow (module docstring; zero in seed 001)
     lift, slip, sin_stall = param(p, P_LIFT, b), param(p, P_SLIP, b), param(p, P_SIN_STALL, b)
     n1 = lift * _pod_normal(ur - y1 * r, vr + x1 * r, sa1, ca1, th1, slip, sin_stall)

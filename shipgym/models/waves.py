@@ -73,6 +73,18 @@ constant in this short-wave limit, multiplies ``2 int S d omega = H_s^2 / 8`` (F
 chapter 5): ``F_i = rho g H_s^2 / 16 int_{L_1} sin^2(theta + beta) n_i dl``. Limits: convex
 wall-sided waterline, zero forward speed, short waves; longer waves pass the hull partly
 unreflected, so this is an upper bound of the drift force at realistic ``T_p``.
+
+Reflection of longer waves (Ursell 1947, "The effect of a fixed vertical barrier on surface
+waves in deep water", Proc. Cambridge Phil. Soc. 43): a fixed vertical wall reaching a depth
+``d`` below the surface reflects the share ``R(kd)`` of a deep-water wave's amplitude::
+
+    R(kd) = pi I_1(kd) / sqrt(pi^2 I_1(kd)^2 + K_1(kd)^2),
+
+``I_1``, ``K_1`` the modified Bessel functions; ``R -> 1`` in short waves, ``R -> 0`` in long
+ones. The drift force goes with the reflected energy, ``R^2``: in a sea,
+:func:`reflection_factor` weights ``R(k d)^2`` by the spectrum (``d`` the ship's draught), the
+factor by which the seaway of the environments (:mod:`shipgym.models.seaway`) scales
+:func:`mean_drift_force`'s short-wave limit.
 """
 
 from __future__ import annotations
@@ -87,6 +99,7 @@ import numpy as np
 import numpy.typing as npt
 import scipy.linalg
 import scipy.optimize
+import scipy.special
 
 from shipgym.models._checks import real_array, require_finite, step_size
 from shipgym.models.angles import ssa
@@ -106,6 +119,7 @@ __all__ = [
     "mean_drift_force",
     "pierson_moskowitz_spectrum",
     "realise_sea",
+    "reflection_factor",
     "wave_response_model",
 ]
 
@@ -657,3 +671,35 @@ def mean_drift_force(
     fy = -c * np.sum(lit * ny, axis=-1)
     n = -c * np.sum(lit * (mid[:, 0] * ny - mid[:, 1] * nx), axis=-1)
     return fx, fy, n
+
+
+def reflection_factor(sea_state: SeaState, draught: float, points: int = 400) -> float:
+    """Spectral mean of the squared reflection coefficient ``R(k d)^2`` of Ursell's barrier
+    (module docstring): ``int S(omega) R^2 d omega / int S(omega) d omega``, the share of
+    :func:`mean_drift_force`'s short-wave limit that a hull of draught ``d`` meets in the sea.
+
+    Parameters
+    ----------
+    sea_state : SeaState
+        The sea.
+    draught : float
+        ``d`` [m] (> 0).
+    points : int
+        Frequencies of the quadrature over ``(0, 5 omega_p]`` (the spectrum above holds less
+        than 0.1 % of ``m0``).
+
+    Returns
+    -------
+    float
+        In ``(0, 1)``: near 1 when the peak wave is short against the draught, small when it
+        is long.
+    """
+    if not isinstance(sea_state, SeaState):
+        raise TypeError(f"sea_state must be a SeaState, got {type(sea_state).__name__}")
+    d = _positive(draught, "draught")
+    w = np.linspace(5.0 * sea_state.peak_frequency / points, 5.0 * sea_state.peak_frequency, points)
+    spectrum = sea_state.spectrum(w)
+    x = np.minimum(w * w / GRAVITY * d, 200.0)
+    # R^2 = 1 / (1 + (K_1 / (pi I_1))^2), with the exponentially scaled Bessel functions
+    ratio = scipy.special.k1e(x) / (math.pi * scipy.special.i1e(x)) * np.exp(-2.0 * x)
+    return float(np.sum(spectrum / (1.0 + ratio * ratio)) / np.sum(spectrum))

@@ -89,7 +89,7 @@ from shipgym.models import (
 )
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.base import MODEL_NAMES
-from shipgym.models.integrate import BECH, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
+from shipgym.models.integrate import BECH, NC, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
 from shipgym.models.model_file import with_rudder_offset
 from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
 from shipgym.sysid.batched import SideBySide, lanes
@@ -416,7 +416,7 @@ def _replay_loop(model_id, width, X0, delta, d0, speed, n_cmd, h, P, out):  # pr
     nx = X0.shape[0]
     x = np.empty((nx, width))  # the variants as a block of ships (states x ships)
     u = np.zeros((2, width))
-    c = np.zeros((2, width))
+    c = np.zeros((NC, width))  # no current, no seaway load
     work = np.empty((3, nx, width))
     for b in range(width):
         for j in range(nx):

@@ -43,7 +43,7 @@ import numpy as np
 
 from shipgym.models import Nomoto1Params, SteeringGear, make_model
 from shipgym.models._jit import kernel
-from shipgym.models.integrate import NOMOTO1, rk4_block
+from shipgym.models.integrate import NC, NOMOTO1, rk4_block
 from shipgym.models.nomoto import IDELTA
 from shipgym.sysid.data import Record
 
@@ -597,7 +597,7 @@ def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
     for j in range(nx):
         x[j, 0] = x0[j]
     u = np.zeros((2, 1))
-    c = np.zeros((2, 1))
+    c = np.zeros((NC, 1))  # no current, no seaway load
     work = np.empty((3, nx, 1))
     out[0] = x[IDELTA, 0]
     for k in range(cmd.shape[0]):

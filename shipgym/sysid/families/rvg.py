@@ -121,7 +121,7 @@ from scipy.signal import savgol_filter
 
 from shipgym.models import RVGParams
 from shipgym.models._jit import kernel, row_kernel
-from shipgym.models.integrate import RVG3DOF, rk4_block
+from shipgym.models.integrate import RVG3DOF, disturbance_block, rk4_block
 from shipgym.models.model_file import rvg_document
 from shipgym.models.rvg import (
     AZIMUTH_TIME_CONSTANT_RANGE,
@@ -505,7 +505,7 @@ def _replay(
     out = np.empty((time.size, pick.size, 10))
     _windows_kernel(
         time, meas, rpm, az, np.asarray(starts, dtype=np.int64), P,
-        np.ascontiguousarray(np.asarray(current, dtype=np.float64)[pick].T),
+        disturbance_block(np.asarray(current, dtype=np.float64)[pick]),
         np.asarray(alpha_0, dtype=np.float64)[pick], np.asarray(v_0, dtype=np.float64)[pick],
         out,
     )  # fmt: skip
