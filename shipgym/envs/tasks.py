@@ -548,8 +548,13 @@ class Task:
             "current_direction": direction,
             "termination_reason": kernels.REASONS[self.reason[i]],
             **self.metrics(i),
-            **(self.seaway.row_info(i) if self.seaway is not None else {}),
+            **(self._seaway_row_info(i) if self.seaway is not None else {}),
         }
+
+    def _seaway_row_info(self, i: int) -> dict[str, Any]:
+        """The seaway's entries of row ``i``'s ``info``, and its measured state."""
+        assert self.seaway is not None
+        return {**self.seaway.row_info(i), "measured_state": self.xm[i].copy()}
 
     def batch_info(self, rows: slice | np.ndarray = slice(None)) -> dict[str, np.ndarray]:
         """The ``info`` of ``rows`` (default all) as arrays: entry ``k`` of each is the value
@@ -577,6 +582,7 @@ class Task:
             info[key] = value if value.base is None else value.copy()
         if self.seaway is not None:
             info.update(self.seaway.info(rows))
+            info["measured_state"] = np.array(self.xm[rows])
         return info
 
 
