@@ -131,13 +131,17 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
     _ended: str | None = None
 
     def __init__(self, render_mode: str | None = None, **task_kwargs: Any) -> None:
+        """``task_kwargs``: the task's (each env's docstring), and ``wind`` and ``sea_state``,
+        the seaway of every episode (:mod:`shipgym.envs.seaway`; none by default)."""
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
         self.render_mode = render_mode
+        wind, sea_state = task_kwargs.pop("wind", None), task_kwargs.pop("sea_state", None)
         self.task = self.task_cls(1, **task_kwargs)
+        self.task.set_seaway(wind, sea_state)
         self.observation_space, self.action_space = self._single_spaces()
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.task.dt)}
         self._renderer: Any = None
@@ -284,7 +288,9 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         :mod:`shipgym.rl.vec_env`, steps without it). Observations, rewards and flags are the
         same either way.
     **task_kwargs
-        Keyword arguments of the task (as for the single env).
+        Keyword arguments of the task (as for the single env), and ``wind`` and ``sea_state``:
+        the seaway of every episode (:mod:`shipgym.envs.seaway`; none by default; a reset's
+        options override them).
 
     Notes
     -----
@@ -351,7 +357,9 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._parks = mode is AutoresetMode.DISABLED  # (a flag read at every step)
         self.keep_options = bool(keep_options)
         self.metadata = {**self.metadata, "autoreset_mode": mode}
+        wind, sea_state = task_kwargs.pop("wind", None), task_kwargs.pop("sea_state", None)
         self.task = self.task_cls(num_envs, **task_kwargs)
+        self.task.set_seaway(wind, sea_state)
         self.task.num_threads = self.num_threads = int(num_threads)
         self.num_envs = int(num_envs)
         steps = self.task.max_episode_steps if max_episode_steps is None else max_episode_steps

@@ -121,10 +121,10 @@ def wind_option(value: Any) -> Wind | None:
         raise ValueError(f"option wind['gusts'] must be True or False, got {gusts!r}")
     direction = value.get("direction")
     return Wind(
-        speed=_number("'wind'", "speed", value["speed"], *WIND_SPEED_RANGE, "m/s"),
+        speed=_number("wind", "speed", value["speed"], *WIND_SPEED_RANGE, "m/s"),
         direction=None
         if direction is None
-        else _number("'wind'", "direction", direction, *ANGLE_RANGE, "rad"),
+        else _number("wind", "direction", direction, *ANGLE_RANGE, "rad"),
         gusts=bool(gusts),
     )
 
@@ -152,10 +152,10 @@ def sea_option(value: Any) -> Sea | None:
             "option 'sea_state' takes the keys 'significant_height' and 'peak_period' "
             f"(required), 'direction' and 'gamma', got {sorted(value)}"
         )
-    height = _number("'sea_state'", "significant_height", value["significant_height"],
+    height = _number("sea_state", "significant_height", value["significant_height"],
                      *HEIGHT_RANGE, "m")  # fmt: skip
-    period = _number("'sea_state'", "peak_period", value["peak_period"], *PERIOD_RANGE, "s")
-    gamma = _number("'sea_state'", "gamma", value.get("gamma", 3.3), *GAMMA_RANGE, "")
+    period = _number("sea_state", "peak_period", value["peak_period"], *PERIOD_RANGE, "s")
+    gamma = _number("sea_state", "gamma", value.get("gamma", 3.3), *GAMMA_RANGE, "")
     if isinstance(gamma, tuple):
         raise ValueError(f"option sea_state['gamma'] must be one number, got {value['gamma']!r}")
     shortest = GRAVITY * _low(period) ** 2 / (2.0 * math.pi)
@@ -171,7 +171,7 @@ def sea_option(value: Any) -> Sea | None:
         peak_period=period,
         direction=None
         if direction is None
-        else _number("'sea_state'", "direction", direction, *ANGLE_RANGE, "rad"),
+        else _number("sea_state", "direction", direction, *ANGLE_RANGE, "rad"),
         gamma=gamma,
     )
 
