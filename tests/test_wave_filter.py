@@ -107,13 +107,67 @@ def test_a_constant_rudder_bias_is_estimated() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"T": -5.0}, "T must be"),
+        ({"T": 0.0}, "T must be"),
         ({"peak_frequency": 0.0}, "peak_frequency must be"),
         ({"wave_heading_std": math.nan}, "wave_heading_std must be"),
         ({"K": 0.0}, "K must be"),
+        ({"peak_frequency": [0.5, -0.1]}, "peak_frequency must be"),
+        ({"peak_frequency": [0.5, 0.6], "wave_heading_std": [0.01, 0.02, 0.03]}, "one value"),
     ],
 )
 def test_bad_parameters_are_refused(kwargs: dict, message: str) -> None:
     args = {"K": K, "T": T, "dt": DT, "peak_frequency": PEAK, "wave_heading_std": 0.02} | kwargs
     with pytest.raises(ValueError, match=message):
         WaveFilter(**args)
+
+
+def test_a_wave_model_per_ship_equals_each_ships_own_filter() -> None:
+    """Three ships with their own encounter frequencies and wave motion: each row is the
+    filter made for that ship alone; a retune gives the design of the new values."""
+    peaks, stds = np.array([0.4, 0.6, 0.9]), np.radians([0.5, 1.5, 3.0])
+    batch = WaveFilter(K, T, DT, peaks, stds)
+    assert batch.ships == 3
+    singles = [WaveFilter(K, T, DT, w, s) for w, s in zip(peaks, stds, strict=True)]
+    waves, _ = _waves(1.5, seed=2)
+    rng = np.random.default_rng(3)
+    rudder = rng.uniform(-0.1, 0.1, (400, 3))
+    batch.reset(np.zeros(3))
+    for f in singles:
+        f.reset(0.0)
+    for k in range(400):
+        psi, r = batch.update(waves[k] * np.array([0.3, 1.0, 2.0]), rudder[k])
+        for i, f in enumerate(singles):
+            psi_i, r_i = f.update(np.array([waves[k] * [0.3, 1.0, 2.0][i]]), rudder[k, i : i + 1])
+            assert psi[i] == pytest.approx(psi_i[0], abs=1e-12)
+            assert r[i] == pytest.approx(r_i[0], abs=1e-12)
+    batch.retune([1], 0.9, math.radians(3.0))
+    np.testing.assert_allclose(batch.gain[1], singles[2].gain, rtol=1e-12)
+    np.testing.assert_allclose(batch.transition[1], singles[2].transition, rtol=1e-12)
+    np.testing.assert_allclose(batch.gain[0], singles[0].gain, rtol=1e-12)
+
+
+def test_retune_needs_a_wave_model_per_ship() -> None:
+    with pytest.raises(ValueError, match="retune needs a filter with a wave model per ship"):
+        WaveFilter(K, T, DT, PEAK, 0.02).retune([0], PEAK, 0.02)
+
+
+def test_a_directionally_unstable_ship_is_filtered() -> None:
+    """An unstable Nomoto ship (T < 0, as seed 001's Gunnerus) held on course by a rudder
+    that cancels its divergence: the filter's LF heading follows the true heading through the
+    waves (its error a fraction of the wave motion)."""
+    k_u, t_u = 0.1, -20.0
+    wave_filter = WaveFilter(k_u, t_u, DT, PEAK, math.radians(1.5))
+    waves, _ = _waves(1.5, seed=4)
+    psi = r = 0.0
+    wave_filter.reset(0.0)
+    errors = []
+    for k in range(int(DURATION / DT)):
+        psi_f, r_f = wave_filter.update(np.array([psi + waves[k]]), np.array([delta]) if k else 0.0)
+        delta = float(-2.0 * psi_f[0] - 40.0 * r_f[0])  # a PD that stabilises the ship
+        for _ in range(10):
+            r += DT / 10 * (k_u * delta - r) / t_u
+            psi += DT / 10 * r
+        errors.append(psi_f[0] - psi)
+    error = np.degrees(np.sqrt(np.mean(np.square(errors[int(SETTLE / DT) :]))))
+    assert error < 0.5  # the waves are 1.5 deg RMS
+    assert abs(math.degrees(psi)) < 2.0

@@ -31,7 +31,9 @@ def _simulate_zigzag(args: argparse.Namespace) -> _Trial:
 
     a = 20.0 if args.angle_deg is None else args.angle_deg
     n = 4 if args.reversals is None else args.reversals
-    res = mv.zigzag(args.ship, a, args.heading_deg, args.side or "starboard", n, dt=args.dt)
+    res = mv.zigzag(
+        args.ship, a, args.heading_deg, args.side or "starboard", n, dt=args.dt, wind=args.wind
+    )
     over = ", ".join("not checked" if math.isnan(o) else f"{o:.2f}" for o in res.overshoots_deg)
     print(
         f"zigzag {res.label} ({res.first} first): {res.particulars.vessel} ({res.model}), "
@@ -54,7 +56,7 @@ def _simulate_turning(args: argparse.Namespace) -> _Trial:
     from shipgym import maneuvers as mv
 
     a = 35.0 if args.angle_deg is None else args.angle_deg
-    res = mv.turning_circle(args.ship, a, args.side or "starboard", dt=args.dt)
+    res = mv.turning_circle(args.ship, a, args.side or "starboard", dt=args.dt, wind=args.wind)
     L = res.particulars.length
     print(
         f"turning circle {math.degrees(res.rudder):g} deg to {res.side}: "
@@ -89,7 +91,7 @@ def _simulate_pullout(args: argparse.Namespace) -> _Trial:
     from shipgym import maneuvers as mv
 
     a = 20.0 if args.angle_deg is None else args.angle_deg
-    res = mv.pullout(args.ship, a, args.side or "starboard", dt=args.dt)
+    res = mv.pullout(args.ship, a, args.side or "starboard", dt=args.dt, wind=args.wind)
     print(
         f"pull-out after {math.degrees(res.rudder):g} deg to {res.side}: "
         f"{res.particulars.vessel} ({res.model})"
@@ -117,7 +119,10 @@ def _simulate_spiral(args: argparse.Namespace) -> _Trial:
         leg = [args.angle_deg * f for f in fractions]
         rudders = [*leg, 0.0, *(-d for d in reversed(leg))]
     kinds = ("direct", "reverse") if args.kind in (None, "both") else (args.kind,)
-    results = [mv.spiral(args.ship, rudders, k, dt=args.dt, progress=progress_line) for k in kinds]
+    results = [
+        mv.spiral(args.ship, rudders, k, dt=args.dt, progress=progress_line, wind=args.wind)
+        for k in kinds
+    ]
     for res in results:
         print(f"{res.kind} spiral: {res.particulars.vessel} ({res.model})")
         print("  rudder [deg]   r [deg/s]   leg")
@@ -130,7 +135,8 @@ def _simulate_spiral(args: argparse.Namespace) -> _Trial:
             )
         else:
             print("  no hysteresis (directionally stable)")
-    payload = {"manoeuvre": "spiral", "spirals": [r.to_dict() for r in results]}
+    spirals = [r.to_dict() for r in results]
+    payload = {"manoeuvre": "spiral", "wind": spirals[0]["wind"], "spirals": spirals}
     return payload, lambda out: mv.plot_spiral(results, out), []
 
 
@@ -141,7 +147,7 @@ def _simulate_imo(args: argparse.Namespace) -> _Trial:
         raise ValueError("--side does not apply to 'imo' (both sides are tested)")
     if args.angle_deg is not None:
         raise ValueError("--angle-deg does not apply to 'imo' (its trials are fixed)")
-    report = mv.imo_criteria(args.ship, dt=args.dt, progress=progress_line)
+    report = mv.imo_criteria(args.ship, dt=args.dt, progress=progress_line, wind=args.wind)
     print(mv.format_imo_table(report))
     print(f"overall: {'PASS' if report.passed else 'FAIL'}")
     return report.to_dict(), lambda out: mv.plot_imo(report, out), []
@@ -156,10 +162,13 @@ _SIMULATE: dict[str, Callable[[argparse.Namespace], _Trial]] = {
 }
 
 
-def wind_option(text: str) -> tuple[float, float]:
+def wind_option(text: str) -> dict[str, float]:
     """``--wind SPEED,DIR``: true wind speed [m/s] and the direction it comes from [deg,
-    clockwise from north]; returned in SI units and radians."""
+    clockwise from north]; returned as the trials' ``wind`` (the env's ``wind`` option: SI
+    units and radians)."""
     import math
+
+    from shipgym.envs.seaway import WIND_SPEED_RANGE
 
     parts = text.split(",")
     try:
@@ -168,27 +177,13 @@ def wind_option(text: str) -> tuple[float, float]:
         raise argparse.ArgumentTypeError(
             f"must be SPEED,DIR (m/s and deg the wind comes from), got {text!r}"
         ) from None
-    if not (math.isfinite(speed) and 0.0 <= speed <= 80.0 and math.isfinite(direction)):
+    low, high = WIND_SPEED_RANGE
+    if not (math.isfinite(speed) and low <= speed <= high and abs(direction) <= 360.0):
         raise argparse.ArgumentTypeError(
-            f"speed must be in [0, 80] m/s and the direction finite, got {text!r}"
+            f"speed must be in [{low:g}, {high:g}] m/s and the direction in [-360, 360] deg, "
+            f"got {text!r}"
         )
-    return speed, math.radians(direction)
-
-
-def _in_wind(ship: Any, model: str, speed: float, direction: float) -> Any:
-    """``ship`` in a constant true wind; the models with wind loads so far: ``kvlcc2``."""
-    import dataclasses
-
-    from shipgym.models import make_model
-
-    if model != "kvlcc2":
-        raise ValueError(
-            f"--wind: wind loads are modelled for kvlcc2 (Blendermann 1994), not for {model!r}"
-        )
-    params = make_model("kvlcc2").params
-    return make_model(
-        "kvlcc2", dataclasses.replace(params, wind_speed=speed, wind_direction=direction)
-    )
+    return {"speed": speed, "direction": math.radians(direction)}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -236,10 +231,19 @@ def run(args: argparse.Namespace) -> int:
         )
     else:
         args.ship = args.model
-    if args.wind is not None:
-        args.ship = _in_wind(args.ship, args.model, *args.wind)
+    if args.gusts:
+        if args.wind is None:
+            raise ValueError("--gusts needs --wind SPEED,DIR (the mean wind)")
+        args.wind["gusts"] = True
     params = f" --params {args.params}" if args.params else ""
     print(f"shipgym simulate {kind} --model {args.model}{params} ...", file=sys.stderr, flush=True)
+    if args.wind is not None:
+        gusts = " with NORSOK gusts" if args.gusts else ", constant"
+        print(
+            f"in a true wind of {args.wind['speed']:g} m/s from "
+            f"{math.degrees(args.wind['direction']) % 360.0:05.1f} deg{gusts} (from the first "
+            "execute on)"
+        )
     payload, draw, rows = _SIMULATE[kind](args)
     if args.model == "rvg3dof":
         payload["params"] = args.ship.params.name
@@ -313,8 +317,17 @@ def build(sub: Any) -> None:
         type=wind_option,
         default=None,
         metavar="SPEED,DIR",
-        help="a constant true wind: speed [m/s] and the direction it comes from [deg, clockwise "
-        "from north], at the model's scale; the turning circle reports its drift (kvlcc2)",
+        help="a constant true wind from the first execute on: speed [m/s] and the direction it "
+        "comes from [deg, clockwise from north], at the model's scale; the turning circle "
+        "reports its drift. The Nomoto family (the Mariner, Isherwood 1972) and rvg3dof "
+        "(Blendermann 1994) through the env's seaway, kvlcc2 through its MMG model's wind, a "
+        "vmm with identified wind terms through its apparent-wind inputs",
+    )
+    p.add_argument(
+        "--gusts",
+        action="store_true",
+        help="with --wind: gusts about the mean wind (the env's NORSOK gust process, one fixed "
+        "realisation; the Nomoto family and rvg3dof)",
     )
     p.add_argument(
         "--angle-deg",

@@ -34,7 +34,19 @@ import numpy as np
 
 from shipgym.models import seaway as sw
 from shipgym.models.rvg import GRAVITY, WATER_DENSITY
-from shipgym.models.waves import GAMMA_RANGE, MAX_STEEPNESS, SeaState
+from shipgym.models.waves import GAMMA_RANGE, MAX_STEEPNESS, SeaState, reflection_factor
+
+__all__ = [
+    "HEIGHT_RANGE",
+    "N_DRAWS",
+    "PERIOD_RANGE",
+    "WIND_SPEED_RANGE",
+    "Sea",
+    "SeawayArrays",
+    "Wind",
+    "sea_option",
+    "wind_option",
+]
 
 WIND_SPEED_RANGE = (0.0, 30.0)
 """Mean wind speed ``U_10`` [m/s] of the ``wind`` option (calm to Beaufort 11)."""
@@ -193,7 +205,7 @@ def _sea_tables(height: float, period: float, gamma: float, length: float, draug
     """Wave-motion gains, drift factor and damping of a sea for a ship (cached: a fixed sea
     costs once)."""
     sea = SeaState(height, period, 0.0, gamma)
-    drift = WATER_DENSITY * GRAVITY * height**2 / 16.0 * sw.reflection_factor(sea, draught)
+    drift = WATER_DENSITY * GRAVITY * height**2 / 16.0 * reflection_factor(sea, draught)
     return sw.wave_motion_gains(sea, length), drift, sw.wave_damping(gamma)
 
 

@@ -8,6 +8,16 @@ copied), held until steady by :func:`hold_until_steady`, and recorded as a
 :class:`TimeSeries`. A model-test ship of any length (``kvlcc2``, ``vmm``) gets the rig of the
 7 m KVLCC2 Froude-scaled (times by ``sqrt(L / 7 m)``, yaw rates by its inverse).
 
+A trial in wind (``wind``, the env's ``wind`` option of :mod:`shipgym.envs.seaway` with one
+speed and direction) runs the same physics as the envs: the Nomoto family (the Mariner) and the
+R/V Gunnerus through the seaway's load (:func:`shipgym.models.seaway.seaway_block` on a
+:class:`~shipgym.envs.seaway.SeawayArrays` of the trial's ship, the load of each step from the
+state at its start, :meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>`'s ``load``),
+``kvlcc2`` through its MMG model's wind (``MMGParams.wind_speed``, ``wind_direction``) and a
+``vmm`` with identified wind terms through its apparent-wind inputs
+(:func:`shipgym.models.wind.apparent_wind` of the state at the start of each step). The wind
+sets in at the first execute on the calm-water approach state.
+
 A private module: the trial modules of :mod:`shipgym.maneuvers` import it; users import
 :class:`TimeSeries` and :data:`SIDES` from the package.
 """
@@ -16,15 +26,20 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from shipgym.envs.seaway import N_DRAWS, SeawayArrays, Wind, wind_option
 from shipgym.maneuvers.particulars import PARTICULARS, ShipParticulars
-from shipgym.models import MODEL_NAMES, ShipModel, SimulationResult, make_model
+from shipgym.models import MODEL_NAMES, NOMOTO_MODEL_NAMES, ShipModel, SimulationResult, make_model
+from shipgym.models import seaway as sw
+from shipgym.models.integrate import NC
 from shipgym.models.model_file import is_model_file, model_info
+from shipgym.models.vmm import FACTORS
+from shipgym.models.wind import apparent_wind
 
 # published as shipgym.maneuvers.SIDES
 SIDES = ("starboard", "port")
@@ -45,6 +60,57 @@ def json_num(value: float | None, digits: int = 6) -> float | None:
 def json_deg(value: float) -> float | None:
     """JSON-friendly degrees of an angle [rad] (``None`` for NaN or infinity)."""
     return json_num(math.degrees(value)) if math.isfinite(value) else None
+
+
+#: Seed of the noise stream of a trial's gusts (one realisation, the same in every run).
+GUST_SEED = 0
+#: The apparent-wind factors of a VMM's terms (:data:`shipgym.models.vmm.FACTORS`).
+_WIND_FACTORS = [FACTORS.index(f) for f in ("wc", "ws", "w2")]
+
+
+def trial_wind(wind: Mapping[str, Any] | None) -> Wind | None:
+    """The checked wind of a trial, or None (calm air).
+
+    ``wind`` is the env's ``wind`` option (:func:`shipgym.envs.seaway.wind_option`): ``speed``
+    [m/s] and ``direction`` (where the wind comes FROM [rad], clockwise from north), both one
+    number here (a trial draws nothing), and ``gusts`` (default False in a trial: a constant
+    true wind is what the trial correction assumes).
+    """
+    if wind is None:
+        return None
+    if not isinstance(wind, Mapping) or "direction" not in wind:
+        raise ValueError(
+            "a trial's wind must be a dict with 'speed' [m/s], 'direction' [rad, where it comes "
+            f"from] and optionally 'gusts' [bool], got {wind!r}"
+        )
+    checked = wind_option({"gusts": False, **wind})
+    assert checked is not None
+    if isinstance(checked.speed, tuple) or isinstance(checked.direction, tuple):
+        raise ValueError(
+            f"a trial's wind is one speed and one direction, not a range, got {wind!r}"
+        )
+    return checked
+
+
+def wind_json(wind: Wind | None) -> dict[str, Any] | None:
+    """A trial's wind for JSON (``None`` in calm air)."""
+    if wind is None:
+        return None
+    return {
+        "speed_m_s": json_num(float(wind.speed)),  # type: ignore[arg-type]
+        "from_deg": json_num(math.degrees(float(wind.direction)) % 360.0),  # type: ignore[arg-type]
+        "gusts": wind.gusts,
+    }
+
+
+def wind_text(wind: Wind | None) -> str:
+    """A trial's wind in words, e.g. ``"true wind 15 m/s from 090 deg"`` (empty in calm air)."""
+    if wind is None:
+        return ""
+    w = wind_json(wind)
+    assert w is not None
+    gusts = ", gusts" if wind.gusts else ""
+    return f"true wind {w['speed_m_s']:g} m/s from {w['from_deg']:05.1f} deg{gusts}"
 
 
 @dataclass(frozen=True)
@@ -204,12 +270,16 @@ class TimeSeries:
 class Rig:
     """One model set up for the trials: approach state, rudder mapping, speed, settings."""
 
-    def __init__(self, model: ModelLike, dt: float | None) -> None:
+    def __init__(
+        self, model: ModelLike, dt: float | None, wind: Mapping[str, Any] | None = None
+    ) -> None:
         identified: ShipParticulars | None = None
+        from_file = False
         if isinstance(model, ShipModel):
             ship = model
         elif is_model_file(model):
             ship = make_model(model)
+            from_file = True
             identified = _identified_particulars(ship, model_info(model))
         elif isinstance(model, str):
             ship = make_model(model)  # raises ValueError for an unknown name
@@ -218,8 +288,13 @@ class Rig:
                 f"model must be a model name {MODEL_NAMES}, a model file FIT.json or a "
                 f"ShipModel, got {model!r}"
             )
-        self.ship = ship
+        #: the model as given (calm air); ``ship`` is the one sailed
+        self.model = ship
         self.name = ship.name
+        self.wind = trial_wind(wind)
+        #: the seaway's ship of a wind load (the Nomoto family, the Gunnerus), else None
+        self.seaway_ship: sw.SeawayShip | None = None
+        self.ship = ship if self.wind is None else self._in_wind(ship, self.wind, from_file)
         if identified is not None:
             self.particulars = identified
         elif ship.name == "kvlcc2":
@@ -281,6 +356,43 @@ class Rig:
             self.x0[ship.index("U")] = ship.surge.service_speed
             self._iU, self._idelta = ship.index("U"), ship.index("delta")
 
+    def _in_wind(self, ship: ShipModel, wind: Wind, from_file: bool) -> ShipModel:
+        """The ship to sail in ``wind``: how each model takes it (module docstring)."""
+        name = ship.name
+        if name in NOMOTO_MODEL_NAMES or name == "rvg3dof":
+            if from_file and name != "rvg3dof":
+                raise ValueError(
+                    "wind: the wind areas are known for the Mariner of the Nomoto family and "
+                    f"the R/V Gunnerus, not for a {name!r} ship identified from a record"
+                )
+            self.seaway_ship = sw.gunnerus_seaway() if name == "rvg3dof" else sw.mariner_seaway()
+            return ship
+        if wind.gusts:
+            raise ValueError(
+                "wind: gusts are modelled for the Nomoto family and rvg3dof (the seaway), not "
+                f"for {name!r}"
+            )
+        if name == "kvlcc2":
+            if ship.params.wind_speed > 0.0:
+                raise ValueError(
+                    f"wind: this kvlcc2 already sails in a wind of {ship.params.wind_speed:g} "
+                    "m/s (MMGParams.wind_speed); give the wind once"
+                )
+            params = replace(ship.params, wind_speed=wind.speed, wind_direction=wind.direction)
+            return ShipModel(name, params, input_delay=ship.input_delay)
+        if not ship.params.terms[:, [1 + k for k in _WIND_FACTORS]].any():
+            raise ValueError(
+                f"wind: the vmm {ship.params.name!r} has no identified wind terms (factors wc, "
+                "ws, w2, e.g. X_wc, Y_ws, N_ws: the 'wind' effect of an identification with a "
+                "measured wind)"
+            )
+        return ship
+
+    def wind_load(self) -> Callable[[float, np.ndarray], np.ndarray] | None:
+        """A new run's wind load for :meth:`ShipModel.simulate
+        <shipgym.models.ShipModel.simulate>` (None: the model takes no load)."""
+        return None if self.seaway_ship is None else _WindLoad(self)
+
     def _rvg_straight_speed(self) -> float:
         """Surge speed [m/s] at which the service thrust balances the resistance."""
         from scipy.optimize import brentq
@@ -295,12 +407,19 @@ class Rig:
 
         return float(brentq(surge_acc, 0.1, 8.0, xtol=1e-12))
 
-    def command(self, delta: float) -> np.ndarray:
-        """Model input for an equivalent rudder command ``delta`` [rad] (+ = starboard)."""
+    def command(self, delta: float, x: np.ndarray | None = None) -> np.ndarray:
+        """Model input for an equivalent rudder command ``delta`` [rad] (+ = starboard) at the
+        state ``x`` (a vmm in wind: the apparent wind of ``x``; calm air without ``x``)."""
         if self.name == "rvg3dof":
             return np.array([self.thrust, self.thrust, -delta, -delta])
         if self.name == "vmm":
-            return np.array([delta, self.shaft, 0.0, 0.0])
+            if self.wind is None or x is None:
+                return np.array([delta, self.shaft, 0.0, 0.0])
+            speed, angle = apparent_wind(
+                float(self.wind.speed), float(self.wind.direction),  # type: ignore[arg-type]
+                x[self.ipsi], x[self._iu], x[self._iv],
+            )  # fmt: skip
+            return np.array([delta, self.shaft, speed, angle])
         return np.array([delta, self.shaft])
 
     def series(self, sim: SimulationResult) -> TimeSeries:
@@ -363,12 +482,41 @@ def side_sign(side: str) -> float:
     return 1.0 if side == "starboard" else -1.0
 
 
+class _WindLoad:
+    """The wind load of one run of a ship of the seaway (module docstring): the env's seaway
+    arrays of one ship with the trial's wind, stepped by the seaway's one function; called by
+    :meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>` at the start of each step."""
+
+    def __init__(self, rig: Rig) -> None:
+        assert rig.seaway_ship is not None
+        self.arrays = SeawayArrays(1, rig.seaway_ship, rig.dt, rig.ir)
+        self.rows = np.zeros(1, dtype=np.int64)
+        self.x = rig.x0[None].copy()
+        self.xm = self.x.copy()
+        self.c = np.zeros((1, NC))
+        draws = np.random.default_rng(GUST_SEED).random((1, N_DRAWS))  # seeds the gusts
+        a = self.arrays
+        a.set_rows(self.rows, rig.wind, None, draws)
+        sw.start_rows(self.rows, self.x, self.c, a.sea, a.wf, a.rng, rig.dt)
+        self.started = False  # the first call sets the first step's load (no gust step)
+
+    def __call__(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The load of the step from ``x`` (rows 2-4 of the disturbances)."""
+        self.x[0] = x
+        a = self.arrays
+        sw.seaway_block(self.rows, 0, 1, self.x, self.c, self.xm, a.sea, a.wf, a.rng, a.tables,
+                        a.gains, a.constants, a.ir, a.dt, self.started)  # fmt: skip
+        self.started = True
+        return self.c[0, 2:]
+
+
 class Run:
     """Closed-loop simulation in chunks with a global clock (the model's ``simulate``)."""
 
     def __init__(self, rig: Rig, controller: Callable[[float, np.ndarray], float]) -> None:
         self.rig = rig
         self.controller = controller
+        self.load = rig.wind_load()
         self.t = 0.0
         self.x = rig.x0.copy()
         self._t: list[np.ndarray] = [np.zeros(1)]
@@ -382,9 +530,9 @@ class Run:
         k0 = round(self.t / rig.dt)
 
         def policy(t: float, x: np.ndarray) -> np.ndarray:
-            return rig.command(self.controller((k0 + round(t / rig.dt)) * rig.dt, x))
+            return rig.command(self.controller((k0 + round(t / rig.dt)) * rig.dt, x), x)
 
-        res = rig.ship.simulate(self.x, policy, rig.dt, n)
+        res = rig.ship.simulate(self.x, policy, rig.dt, n, load=self.load)
         times = (k0 + np.arange(1, n + 1)) * rig.dt
         self._t.append(times)
         self._x.append(res.states[1:])

@@ -21,11 +21,19 @@ more; for R/V Gunnerus (33.9 m) the table is informative only.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TextIO
 
-from shipgym.maneuvers._common import SIDES, ModelLike, Progress, Rig, json_num, side_sign
+from shipgym.maneuvers._common import (
+    SIDES,
+    ModelLike,
+    Progress,
+    Rig,
+    json_num,
+    side_sign,
+    wind_json,
+)
 from shipgym.maneuvers.particulars import ShipParticulars
 from shipgym.maneuvers.turning import (
     InitialTurningResult,
@@ -235,6 +243,7 @@ class IMOReport:
             "speed_m_s": self.particulars.speed,
             "length_over_speed_s": json_num(self.particulars.length_over_speed),
             "passed": self.passed,
+            "wind": wind_json(self.turning[0].wind if self.turning else None),
             "rows": [row.to_dict() for row in self.rows],
             "turning": [t.to_dict(include_series=False) for t in self.turning],
             "initial_turning": [i.to_dict() for i in self.initial],
@@ -248,6 +257,7 @@ def imo_criteria(
     sides: Sequence[str] = SIDES,
     dt: float | None = None,
     progress: Progress = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> IMOReport:
     """Run the trials of MSC.137(76) to each side and check the criteria.
 
@@ -264,6 +274,9 @@ def imo_criteria(
         Integration step [s].
     progress : callable, optional
         Called with a one-line message after each trial.
+    wind : dict, optional
+        A constant true wind in every trial, as :func:`~shipgym.maneuvers.turning_circle`'s
+        (the criteria are for calm water: a trial in wind is corrected for it).
 
     Returns
     -------
@@ -273,18 +286,18 @@ def imo_criteria(
         raise ValueError(f"sides must name at least one of {SIDES}, got {sides!r}")
     for side in sides:
         side_sign(side)
-    rig = Rig(model, dt)
-    ship = rig.ship
+    rig = Rig(model, dt, wind)
+    ship = rig.model
     say = progress or (lambda msg: None)
     turning, initial, z10, z20 = [], [], [], []
     for side in sides:
-        turning.append(turning_circle(ship, 35.0, side, dt=rig.dt))
+        turning.append(turning_circle(ship, 35.0, side, dt=rig.dt, wind=wind))
         say(f"turning circle 35 deg to {side}: done")
-        initial.append(initial_turning(ship, 10.0, 10.0, side, dt=rig.dt))
+        initial.append(initial_turning(ship, 10.0, 10.0, side, dt=rig.dt, wind=wind))
         say(f"initial turning 10 deg to {side}: done")
-        z10.append(zigzag(ship, 10.0, 10.0, side, n_reversals=2, dt=rig.dt))
+        z10.append(zigzag(ship, 10.0, 10.0, side, n_reversals=2, dt=rig.dt, wind=wind))
         say(f"zigzag 10/10 {side} first: done")
-        z20.append(zigzag(ship, 20.0, 20.0, side, n_reversals=1, dt=rig.dt))
+        z20.append(zigzag(ship, 20.0, 20.0, side, n_reversals=1, dt=rig.dt, wind=wind))
         say(f"zigzag 20/20 {side} first: done")
     rows = imo_rows(rig.particulars, turning, initial, z10 + z20)
     return IMOReport(

@@ -19,7 +19,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from shipgym.maneuvers._common import crossing, side_sign, value_at
+from shipgym.envs.seaway import Wind
+from shipgym.maneuvers._common import crossing, side_sign, value_at, wind_text
 from shipgym.maneuvers.imo import IMOReport
 from shipgym.maneuvers.particulars import ShipParticulars
 from shipgym.maneuvers.pullouts import PullOutResult
@@ -57,8 +58,10 @@ def _new_figure(size: tuple[float, float]) -> Figure:
     return fig
 
 
-def _title(model: str, particulars: ShipParticulars, what: str) -> str:
-    return f"{what}: {particulars.vessel}, {_MODEL_LABELS.get(model, model)} model ({model})"
+def _title(model: str, particulars: ShipParticulars, what: str, wind: Wind | None) -> str:
+    """The title of a trial's figure (the wind, if any, on a line of its own)."""
+    title = f"{what}: {particulars.vessel}, {_MODEL_LABELS.get(model, model)} model ({model})"
+    return title if wind is None else f"{title}\nin a {wind_text(wind)}"
 
 
 def _save(fig: Figure, path: str | Path) -> Path:
@@ -182,7 +185,12 @@ def plot_zigzag(result: ZigZagResult, path: str | Path) -> Path:
         zorder=10,
     )
     ax.set_title(
-        _title(result.model, result.particulars, f"Zigzag {result.label} ({result.first} first)")
+        _title(
+            result.model,
+            result.particulars,
+            f"Zigzag {result.label} ({result.first} first)",
+            result.wind,
+        )
         + f", U = {result.approach_speed:.2f} m/s",
         fontsize=11,
     )
@@ -426,7 +434,9 @@ def plot_turning_circle(result: TurningResult, path: str | Path) -> Path:
     for axis in (ax_r, ax_v):
         axis.tick_params(labelbottom=False)
     ax_r.set_title("phases (seed 002): 1st rudder moving, 2nd transient, 3rd steady", fontsize=9)
-    fig.suptitle(_title(result.model, result.particulars, "Turning circle"), fontsize=11.5)
+    fig.suptitle(
+        _title(result.model, result.particulars, "Turning circle", result.wind), fontsize=11.5
+    )
     return _save(fig, path)
 
 
@@ -472,6 +482,7 @@ def plot_pullout(result: PullOutResult, path: str | Path) -> Path:
             result.model,
             result.particulars,
             f"Pull-out after {math.degrees(result.rudder):g}° to {result.side}",
+            result.wind,
         )
         + f"\n{verdict}{extra}",
         fontsize=11,
@@ -574,7 +585,7 @@ def plot_spiral(results: SpiralResult | Sequence[SpiralResult], path: str | Path
     )
     res0 = items[0]
     ax.set_title(
-        _title(res0.model, res0.particulars, "Spiral test, the δ-r curve")
+        _title(res0.model, res0.particulars, "Spiral test, the δ-r curve", res0.wind)
         + f"\napproach {res0.approach_speed:.2f} m/s",
         fontsize=11,
     )
@@ -615,6 +626,9 @@ def plot_imo(report: IMOReport, path: str | Path) -> Path:
     ax.grid(True, axis="x", alpha=0.3)
     p = report.particulars
     note = "" if p.length >= 100.0 else " (L < 100 m: informative only)"
+    wind = report.turning[0].wind if report.turning else None
+    if wind is not None:
+        note += f", in a {wind_text(wind)}"
     fig.suptitle(
         f"IMO MSC.137(76): {p.vessel} ({report.model}), L = {p.length:g} m, U = {p.speed:g} m/s, "
         f"L/U = {p.length_over_speed:.1f} s{note}\noverall: "

@@ -8,11 +8,13 @@ the pull-out; an unstable one keeps a residual yaw rate (the height of its spira
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -22,6 +24,7 @@ from shipgym.maneuvers._common import (
     json_deg,
     json_num,
     side_sign,
+    wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
 
@@ -34,7 +37,7 @@ class PullOutResult:
 
     Attributes
     ----------
-    model, particulars, approach_speed, rudder, side, series
+    model, particulars, approach_speed, rudder, side, series, wind
         As in :class:`TurningResult`.
     pullout_time : float
         Time the rudder is returned to amidships [s].
@@ -64,6 +67,7 @@ class PullOutResult:
     stable: bool
     settled: bool
     dt: float
+    wind: Wind | None = None
 
     def to_dict(self, include_series: bool = True) -> dict[str, Any]:
         """Metrics (and time series) for JSON; degrees in ``*_deg`` keys."""
@@ -82,6 +86,7 @@ class PullOutResult:
             "decay_time_s": json_num(self.decay_time),
             "stable": self.stable,
             "settled": self.settled,
+            "wind": wind_json(self.wind),
         }
         if include_series:
             d["series"] = self.series.to_dict()
@@ -93,13 +98,15 @@ def pullout(
     rudder_deg: float = 20.0,
     side: str = "starboard",
     dt: float | None = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> PullOutResult:
-    """Pull-out trial: turn with ``rudder_deg`` to ``side`` until steady, then rudder 0.
+    """Pull-out trial: turn with ``rudder_deg`` to ``side`` until steady, then rudder 0 (in a
+    true ``wind`` as :func:`~shipgym.maneuvers.turning_circle`'s).
 
     The yaw rate after the pull-out is followed until it settles; a residual yaw rate above
     5 % of the turning rate marks a directionally unstable ship.
     """
-    rig = Rig(model, dt)
+    rig = Rig(model, dt, wind)
     delta = rig.check_rudder(rudder_deg, "pull-out rudder_deg")
     s = side_sign(side)
     state = {"delta": s * delta}
@@ -127,4 +134,5 @@ def pullout(
         stable=abs(r_res) <= 0.05 * abs(r_turn),
         settled=settled,
         dt=rig.dt,
+        wind=rig.wind,
     )

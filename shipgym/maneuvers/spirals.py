@@ -12,12 +12,13 @@ the loop. For the Norrbin model the steady curve is ``n3 r^3 + n2 r|r| + n1 r + 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Progress,
@@ -27,6 +28,7 @@ from shipgym.maneuvers._common import (
     hold_until_steady,
     json_deg,
     json_num,
+    wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
 
@@ -39,7 +41,7 @@ class SpiralResult:
 
     Attributes
     ----------
-    model, particulars, approach_speed, series
+    model, particulars, approach_speed, series, wind
         As in :class:`ZigZagResult`.
     kind : str
         ``"direct"`` (Dieudonné) or ``"reverse"`` (Bech).
@@ -82,6 +84,7 @@ class SpiralResult:
     loop_width: float
     series: TimeSeries
     dt: float
+    wind: Wind | None = None
 
     def to_dict(self, include_series: bool = False) -> dict[str, Any]:
         """The delta-r points for JSON; degrees in ``*_deg`` keys."""
@@ -101,6 +104,7 @@ class SpiralResult:
             "saturated": [bool(v) for v in self.saturated],
             "hysteresis": self.hysteresis,
             "loop_width_deg": json_deg(self.loop_width),
+            "wind": wind_json(self.wind),
         }
         if self.setpoints is not None:
             d["yaw_rate_setpoint_deg_s"] = [json_deg(v) for v in self.setpoints]
@@ -149,6 +153,7 @@ def spiral(
     return_leg: bool = True,
     dt: float | None = None,
     progress: Progress = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> SpiralResult:
     """Direct (Dieudonné) or reverse (Bech) spiral: the steady delta-r curve.
 
@@ -171,12 +176,14 @@ def spiral(
         Integration step [s].
     progress : callable, optional
         Called with a one-line message after each point.
+    wind : dict, optional
+        A constant true wind from the start on, as :func:`~shipgym.maneuvers.turning_circle`'s.
 
     Returns
     -------
     SpiralResult
     """
-    rig = Rig(model, dt)
+    rig = Rig(model, dt, wind)
     if kind not in ("direct", "reverse"):
         raise ValueError(f"spiral kind must be 'direct' or 'reverse', got {kind!r}")
     limit_deg = math.degrees(rig.max_rudder)
@@ -270,4 +277,5 @@ def spiral(
         loop_width=width,
         series=rig.series(run.result()),
         dt=rig.dt,
+        wind=rig.wind,
     )

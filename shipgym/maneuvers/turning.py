@@ -15,12 +15,13 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -32,6 +33,7 @@ from shipgym.maneuvers._common import (
     json_num,
     side_sign,
     value_at,
+    wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
 
@@ -89,6 +91,8 @@ class TurningResult:
     drift_speed, drift_direction : float
         That drift over the turn's duration [m/s] and the direction it goes toward [rad],
         clockwise from north (NaN without drift).
+    wind : Wind or None
+        The true wind of the trial (:func:`turning_circle`'s ``wind``), None in calm air.
     """
 
     model: str
@@ -117,6 +121,7 @@ class TurningResult:
     drift: tuple[float, float] = (0.0, 0.0)
     drift_speed: float = 0.0
     drift_direction: float = math.nan
+    wind: Wind | None = None
 
     def to_dict(self, include_series: bool = True) -> dict[str, Any]:
         """Metrics (and time series) for JSON; degrees in ``*_deg`` keys."""
@@ -151,6 +156,7 @@ class TurningResult:
             "drift_m": [json_num(self.drift[0]), json_num(self.drift[1])],
             "drift_speed_m_s": json_num(self.drift_speed),
             "drift_direction_deg": json_deg(self.drift_direction),
+            "wind": wind_json(self.wind),
             "speed_vs_heading_change": {
                 "heading_change_deg": [json_deg(h) for h in self.heading_changes],
                 "speed_m_s": [json_num(v) for v in self.speeds],
@@ -166,6 +172,7 @@ def turning_circle(
     rudder_deg: float = 35.0,
     side: str = "starboard",
     dt: float | None = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> TurningResult:
     """Simulate a turning circle with ``rudder_deg`` to ``side``.
 
@@ -183,6 +190,12 @@ def turning_circle(
         Turn direction.
     dt : float, optional
         Integration step [s].
+    wind : dict, optional
+        A constant true wind from the first execute on: ``speed`` [m/s], ``direction`` (where
+        it comes FROM [rad], clockwise from north) and ``gusts`` (default False), the env's
+        ``wind`` option (:mod:`shipgym.envs.seaway`); its drift over the steady turn is
+        :attr:`TurningResult.drift`. For the Nomoto family (the Mariner), ``rvg3dof``,
+        ``kvlcc2`` and a ``vmm`` with identified wind terms.
 
     Returns
     -------
@@ -193,7 +206,7 @@ def turning_circle(
     ValueError
         For bad arguments, or if the heading never changes 180 deg within the longest hold.
     """
-    rig = Rig(model, dt)
+    rig = Rig(model, dt, wind)
     delta = rig.check_rudder(rudder_deg, "turning circle rudder_deg")
     s = side_sign(side)
     run = Run(rig, lambda t, x: s * delta)
@@ -271,6 +284,7 @@ def turning_circle(
         drift=drift,
         drift_speed=drift_speed,
         drift_direction=drift_direction,
+        wind=rig.wind,
     )
 
 
@@ -280,7 +294,7 @@ class InitialTurningResult:
 
     Attributes
     ----------
-    model, particulars, approach_speed, rudder, side, series
+    model, particulars, approach_speed, rudder, side, series, wind
         As in :class:`TurningResult`.
     heading : float
         Heading change [rad] at which the distance is measured (10 deg).
@@ -303,6 +317,7 @@ class InitialTurningResult:
     time: float
     series: TimeSeries
     dt: float
+    wind: Wind | None = None
 
     def to_dict(self, include_series: bool = False) -> dict[str, Any]:
         """Metrics (and time series) for JSON."""
@@ -316,6 +331,7 @@ class InitialTurningResult:
             "distance_L": json_num(self.distance / self.particulars.length),
             "advance_m": json_num(self.advance),
             "time_s": json_num(self.time),
+            "wind": wind_json(self.wind),
         }
         if include_series:
             d["series"] = self.series.to_dict()
@@ -328,16 +344,18 @@ def initial_turning(
     heading_deg: float = 10.0,
     side: str = "starboard",
     dt: float | None = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> InitialTurningResult:
     """Initial turning test (MSC.137(76) 5.3.2): rudder to ``rudder_deg`` until the heading
-    has changed ``heading_deg``; the distance travelled along the track is measured.
+    has changed ``heading_deg``; the distance travelled along the track is measured (in a
+    true ``wind`` as :func:`turning_circle`'s).
 
     Raises
     ------
     ValueError
         For bad arguments or if the heading change is not reached within the longest hold.
     """
-    rig = Rig(model, dt)
+    rig = Rig(model, dt, wind)
     delta = rig.check_rudder(rudder_deg, "initial turning rudder_deg")
     if not (isinstance(heading_deg, int | float) and math.isfinite(heading_deg)):
         raise ValueError(f"heading_deg must be a finite angle, got {heading_deg!r}")
@@ -372,4 +390,5 @@ def initial_turning(
         time=value_at(series.time, cross),
         series=series.crop(i + 1),
         dt=rig.dt,
+        wind=rig.wind,
     )

@@ -13,11 +13,13 @@ full heading cycle). The reversal is applied at the integration step nearest to 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -26,6 +28,7 @@ from shipgym.maneuvers._common import (
     json_deg,
     json_num,
     side_sign,
+    wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
 
@@ -66,6 +69,8 @@ class ZigZagResult:
         Mean time between every other reversal [s] (NaN with fewer than three reversals).
     completed : bool
         All requested reversals happened and every swing was checked.
+    wind : Wind or None
+        The true wind of the trial (:func:`zigzag`'s ``wind``), None in calm air.
     """
 
     model: str
@@ -83,6 +88,7 @@ class ZigZagResult:
     period: float
     completed: bool
     dt: float
+    wind: Wind | None = None
 
     @property
     def overshoots_deg(self) -> tuple[float, ...]:
@@ -114,6 +120,7 @@ class ZigZagResult:
             "initial_turning_time_s": json_num(self.initial_turning_time),
             "time_to_check_yaw_s": json_num(self.time_to_check_yaw),
             "period_s": json_num(self.period),
+            "wind": wind_json(self.wind),
         }
         if include_series:
             d["series"] = self.series.to_dict()
@@ -169,6 +176,7 @@ def zigzag(
     n_reversals: int = 4,
     dt: float | None = None,
     max_duration: float | None = None,
+    wind: Mapping[str, Any] | None = None,
 ) -> ZigZagResult:
     """Simulate a zigzag ``a/b`` trial (Kempf's Z-manoeuvre, seed 000).
 
@@ -188,6 +196,9 @@ def zigzag(
         Integration step [s] (default 0.1 s).
     max_duration : float, optional
         Longest simulated time [s] (default 4000 s Nomoto, 600 s RVG).
+    wind : dict, optional
+        A constant true wind from the first execute on, as
+        :func:`~shipgym.maneuvers.turning_circle`'s.
 
     Returns
     -------
@@ -195,7 +206,7 @@ def zigzag(
         ``completed`` is False when the swing after a reversal was never checked within
         ``max_duration`` (its overshoot is NaN), as for a strongly unstable ship.
     """
-    rig = Rig(model, dt)
+    rig = Rig(model, dt, wind)
     a = rig.check_rudder(a_deg, "zigzag rudder angle a_deg")
     b_deg = a_deg if b_deg is None else b_deg
     if not (isinstance(b_deg, int | float) and math.isfinite(b_deg) and 0 < b_deg <= 90):
@@ -258,6 +269,7 @@ def zigzag(
         period=period,
         completed=completed,
         dt=rig.dt,
+        wind=rig.wind,
     )
 
 

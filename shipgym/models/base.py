@@ -497,6 +497,19 @@ class ShipModel:
             )
         return arr.reshape(self.nu)
 
+    def _load(self, value: Any, t: float) -> np.ndarray:
+        """A load callback's output as a checked ``(3,)`` array."""
+        try:
+            arr = real_array(value, "load")
+        except TypeError:
+            arr = None
+        if arr is None or arr.shape != (integrate.NC - 2,) or not np.isfinite(arr).all():
+            raise ValueError(
+                f"the load must return an array of shape ({integrate.NC - 2},) of finite "
+                f"numbers; at t={t:g} s it returned {type(value).__name__} {short_repr(value)}"
+            )
+        return arr
+
     def simulate(
         self,
         x0: npt.ArrayLike,
@@ -504,6 +517,7 @@ class ShipModel:
         dt: float,
         n_steps: int | None = None,
         current: npt.ArrayLike | None = None,
+        load: Callable[[float, np.ndarray], npt.ArrayLike] | None = None,
     ) -> SimulationResult:
         """Simulate one ship with fixed-step RK4.
 
@@ -526,6 +540,15 @@ class ShipModel:
             callable.
         current : array_like or Current, optional
             North/east current [m/s], shape ``(2,)``.
+        load : callable, optional
+            ``(t, x) -> (3,)``: the external load of the coming step from the state ``x`` at
+            its start (after the policy), held over the step like the current: rows 2-4 of the
+            disturbances (:data:`shipgym.models.integrate.NC`), for ``rvg3dof`` the surge and
+            sway force [N] and the yaw moment [N m] about its origin, for the Nomoto family the
+            equivalent rudder angle [rad] and the leeway [m/s] (the third entry unused). The
+            seaway's load is :func:`shipgym.models.seaway.seaway_block`'s. The Nomoto family
+            and ``rvg3dof`` only (``kvlcc2`` takes its wind in its parameters, ``vmm`` in its
+            inputs).
 
         Returns
         -------
@@ -535,8 +558,8 @@ class ShipModel:
         ------
         TypeError, ValueError
             For bad arguments (class docstring, Notes), a policy output that is not a finite
-            ``(nu,)`` input, a step beyond the stable RK4 step and a state that becomes
-            non-finite (naming the time).
+            ``(nu,)`` input, a load that is not a finite ``(3,)`` array, a step beyond the
+            stable RK4 step and a state that becomes non-finite (naming the time).
         """
         dt = step_size(dt)
         x = self._single(
@@ -544,6 +567,13 @@ class ShipModel:
             ": one ship's state (simulate runs one ship; step() takes a batch)",
         )  # fmt: skip
         c = self._currents(current, 1)
+        if load is not None:
+            if self.model_id >= integrate.KVLCC2:
+                raise ValueError(
+                    f"load applies to the Nomoto family and rvg3dof, not to model {self.name!r} "
+                    "(kvlcc2 takes its wind in its parameters, vmm in its inputs)"
+                )
+            c = np.concatenate((c, np.zeros((1, integrate.NC - 2))), axis=1)
         if callable(inputs):
             if n_steps is None:
                 raise ValueError("n_steps must be >= 1 when inputs is a function, got None")
@@ -584,6 +614,8 @@ class ShipModel:
             u[0] = u_seq[k]
             if delay is not None:
                 u[0, 0] = delay.push(u[:, :1])[0, 0]
+            if load is not None:
+                c[0, 2:] = self._load(load(time[k], x[0].copy()), time[k])
             integrate.rk4_step_kernel(self.model_id, x, u, self.p, c, dt)
             states[k + 1] = x[0]
         if not np.isfinite(states).all():

@@ -85,7 +85,6 @@ from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, GRAVITY, LPP, WATER_DENSITY
 from shipgym.models.vmath import atan2, sincos
 from shipgym.models.waves import SeaState, box_waterline, fit_wave_response, mean_drift_force
-from shipgym.models.waves import reflection_factor as _reflection_factor
 
 __all__ = [
     "ANGLE_STEP",
@@ -95,6 +94,9 @@ __all__ = [
     "gunnerus_seaway",
     "gust_parameters",
     "mariner_seaway",
+    "seaway_block",
+    "start_rows",
+    "wave_damping",
     "wave_motion_gains",
 ]
 
@@ -240,11 +242,6 @@ def wave_motion_gains(sea_state: SeaState, length: float, points: int = 200) -> 
     rms_xi = np.sqrt(weight @ (xi * xi))
     rms_yaw = np.sqrt(weight @ (yaw * yaw)) * np.sign(weight @ yaw)
     return 4.0 * np.stack((rms_xi, rms_yaw))  # per metre of H_s / 4
-
-
-def reflection_factor(sea_state: SeaState, draught: float) -> float:
-    """:func:`shipgym.models.waves.reflection_factor` (the drift's share in this sea)."""
-    return _reflection_factor(sea_state, draught)
 
 
 def wave_damping(gamma: float) -> float:
