@@ -168,9 +168,10 @@ def evaluate_all(
             result = evaluate(ENV_ID, policy, name, episodes, seed, env_kwargs=kwargs,
                               progress=lambda line: None, condition=water)  # fmt: skip
             out[name, water] = summary(result)
+            mean = out[name, water]["return"]["mean"]
             _print(
                 f"evaluated {name} in {water} water: {episodes} episodes in "
-                f"{time.perf_counter() - start:.1f} s, return {out[name, water]['return']['mean']:.1f}"
+                f"{time.perf_counter() - start:.1f} s, return {mean:.1f}"
             )
     return out
 
@@ -225,7 +226,7 @@ def plot(
         for j, water in enumerate(("calm", "seaway")):
             s = [results[name, water][key] for name in agents]
             mean = np.array([v["mean"] for v in s])
-            err = np.array([[m - v["ci95"][0], v["ci95"][1] - m] for m, v in zip(mean, s)]).T
+            err = np.array([[v["mean"] - v["ci95"][0], v["ci95"][1] - v["mean"]] for v in s]).T
             ax.bar(x + (j - 0.5) * width, mean, width, yerr=err, capsize=3,
                    label=f"in {water} water")  # fmt: skip
         ax.set_xticks(x, agents)
@@ -243,17 +244,34 @@ def main(argv: list[str]) -> int:
     from shipgym.rl.train import BENCHMARK_SEED, config
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--out", type=Path, default=ROOT / "out" / "seaway_retraining",
-                        help="folder of the retrained agent (default: out/seaway_retraining)")
-    parser.add_argument("--timesteps", type=int, default=config(ENV_ID, ALGO)["timesteps"],
-                        help="training steps (default: the shipped agent's budget)")
-    parser.add_argument("--episodes", type=int, default=100,
-                        help="evaluation episodes per case (default: the benchmark's 100)")
-    parser.add_argument("--retrain", action="store_true",
-                        help="train anew even if DIR holds a finished agent of this seaway")
-    parser.add_argument("--docs", action="store_true",
-                        help=f"write {FIGURE.relative_to(ROOT)} and the table of "
-                        f"{PAGE.relative_to(ROOT)}")  # fmt: skip
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=ROOT / "out" / "seaway_retraining",
+        help="folder of the retrained agent (default: out/seaway_retraining)",
+    )
+    parser.add_argument(
+        "--timesteps",
+        type=int,
+        default=config(ENV_ID, ALGO)["timesteps"],
+        help="training steps (default: the shipped agent's budget)",
+    )
+    parser.add_argument(
+        "--episodes",
+        type=int,
+        default=100,
+        help="evaluation episodes per case (default: the benchmark's 100)",
+    )
+    parser.add_argument(
+        "--retrain",
+        action="store_true",
+        help="train anew even if DIR holds a finished agent of this seaway",
+    )
+    parser.add_argument(
+        "--docs",
+        action="store_true",
+        help=f"write {FIGURE.relative_to(ROOT)} and the table of {PAGE.relative_to(ROOT)}",
+    )
     args = parser.parse_args(argv)
     if args.timesteps < 1 or args.episodes < 2:
         parser.error(
