@@ -61,7 +61,7 @@ def test_single_equals_vector_at_sea(env_id: str) -> None:
     rng = np.random.default_rng(0)
     for _ in range(60):
         a = rng.uniform(-1, 1, (n, *venv.single_action_space.shape)).astype(np.float32)
-        obs, rew, term, trunc, info = venv.step(a)
+        obs, rew, term, _, info = venv.step(a)
         for i, env in enumerate(singles):
             o, r, t, _, inf = env.step(a[i])
             np.testing.assert_array_equal(obs[i], o)
