@@ -14,6 +14,12 @@ a fifth less compile time, than with the model chosen at run time), and they ref
 Conventions: NED, heading clockwise from north, SI units and radians; the normalised action
 ``a`` is clipped to [-1, 1] and mapped to the model input by ``u = u0 + B a``.
 
+At sea (:mod:`shipgym.models.seaway`) a kernel takes the seaway of its rows (``sw``) and their
+measured states ``xm``: after each block's step (or at a reset) the seaway sets the block's
+measured states and its load of the next step; the observations are formed from ``xm``, the
+rewards, terminations and task logic from ``x``. In calm water ``sw[0]`` is False and ``xm``
+is ``x`` itself, so nothing changes.
+
 Every task kernel returns the first row whose action is not finite (then nothing was
 stepped), or -1. It takes ``advance`` and ``rows`` first: ``advance=True`` steps the whole
 batch, ``False`` only computes the observations of the current state (after a reset); either

@@ -7,6 +7,11 @@ the initial conditions with NumPy, for all rows being reset at once. The single 
 a batch of one, so the vector environment's sub-env ``i`` seeded with ``s + i`` reproduces the
 single environment seeded with ``s`` exactly, and autoresets of many sub-envs cost one pass.
 
+Wind and waves: ``wind`` and ``sea_state`` (:mod:`shipgym.envs.seaway`), in the env's
+constructor (:meth:`Task.set_seaway`) or ``reset(options=...)``; off by default. At sea a
+task's kernel forms the observations from the measured states ``xm`` (the states plus the
+wave-frequency motion, :mod:`shipgym.models.seaway`) and the rewards from the states.
+
 Current in ``reset(options=...)``: ``current_speed`` [m/s, 0 to the ship's top speed] and
 ``current_direction`` [rad, the direction the water moves toward, clockwise from north].
 Without them the speed is drawn uniformly from ``[0, max_current_speed]`` and the direction
