@@ -16,7 +16,8 @@ state at its start, :meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate
 ``kvlcc2`` through its MMG model's wind (``MMGParams.wind_speed``, ``wind_direction``) and a
 ``vmm`` with identified wind terms through its apparent-wind inputs
 (:func:`shipgym.models.wind.apparent_wind` of the state at the start of each step). The wind
-sets in at the first execute on the calm-water approach state.
+sets in at the first execute on the approach state of calm water (the KVLCC2's propeller at
+the self-propulsion point of its MMG model in the wind on the approach heading).
 
 A private module: the trial modules of :mod:`shipgym.maneuvers` import it; users import
 :class:`TimeSeries` and :data:`SIDES` from the package.
@@ -338,9 +339,10 @@ class Rig:
             self._iu, self._iv = ship.index("u"), ship.index("v")
             self._ia = (ship.index("alpha1"), ship.index("alpha2"))
         elif ship.name in ("kvlcc2", "vmm"):
-            p = ship.params
+            p = self.ship.params
             self.max_rudder = float(p.max_rudder)
-            # the propeller at the self-propulsion point (kvlcc2: rps; vmm: the thrust input)
+            # the propeller at the self-propulsion point (kvlcc2: rps, with its MMG wind on the
+            # approach heading; vmm: the thrust input)
             self.shaft = (
                 p.self_propulsion_rps(self.particulars.speed)
                 if ship.name == "kvlcc2"
