@@ -12,11 +12,11 @@ import scipy.integrate
 import scipy.signal
 
 import shipgym  # noqa: F401  (registers the envs)
-from shipgym.envs.seaway import SeawayArrays, sea_option, wind_option
 from shipgym.models import seaway as sw
 from shipgym.models import wind as W
 from shipgym.models.angles import ssa
 from shipgym.models.rvg import CG_FORWARD_OF_AP, GRAVITY, LPP
+from shipgym.models.seaway_options import SeawayArrays, sea_option, wind_option
 from shipgym.models.waves import (
     SeaState,
     box_waterline,

@@ -168,7 +168,7 @@ def wind_option(text: str) -> dict[str, float]:
     units and radians)."""
     import math
 
-    from shipgym.envs.seaway import WIND_SPEED_RANGE
+    from shipgym.models.seaway_options import WIND_SPEED_RANGE
 
     parts = text.split(",")
     try:

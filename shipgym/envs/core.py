@@ -132,7 +132,7 @@ class ShipEnv(_Spaces, gym.Env[np.ndarray, np.ndarray]):
 
     def __init__(self, render_mode: str | None = None, **task_kwargs: Any) -> None:
         """``task_kwargs``: the task's (each env's docstring), and ``wind`` and ``sea_state``,
-        the seaway of every episode (:mod:`shipgym.envs.seaway`; none by default)."""
+        the seaway of every episode (:mod:`shipgym.models.seaway_options`; none by default)."""
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -289,8 +289,8 @@ class ShipVectorEnv(_Spaces, VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         same either way.
     **task_kwargs
         Keyword arguments of the task (as for the single env), and ``wind`` and ``sea_state``:
-        the seaway of every episode (:mod:`shipgym.envs.seaway`; none by default; a reset's
-        options override them).
+        the seaway of every episode (:mod:`shipgym.models.seaway_options`; none by default; a
+        reset's options override them).
 
     Notes
     -----

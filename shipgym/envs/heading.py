@@ -74,10 +74,10 @@ class NomotoHeadingEnv(ShipEnv):
     ``info`` holds ``state`` (names in ``env.unwrapped.state_names``), ``current_speed``,
     ``current_direction``, ``heading_error``, ``heading_setpoint`` and ``termination_reason``.
     At sea (``wind`` and ``sea_state``, in the constructor for every episode or in the reset
-    options; :mod:`shipgym.envs.seaway`, off by default) the observations are formed from the
-    measured state (the wave-frequency motion added to heading, yaw rate and position), the
-    reward from the low-frequency one, and ``info`` adds ``wind``, ``sea_state``,
-    ``wave_motion`` and ``measured_state``.
+    options; :mod:`shipgym.models.seaway_options`, off by default) the observations are
+    formed from the measured state (the wave-frequency motion added to heading, yaw rate and
+    position), the reward from the low-frequency one, and ``info`` adds ``wind``,
+    ``sea_state``, ``wave_motion`` and ``measured_state``.
 
     Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
     range), from the ship's top speed V = 9.9 m/s (at the largest shaft speed) and length

@@ -69,10 +69,10 @@ class RVGPathFollowingEnv(ShipEnv):
     (2 to 16 (north, east) points [m]). ``info`` holds ``state``, the current,
     ``cross_track_error``, ``segment``, ``completed`` and ``termination_reason``.
     At sea (``wind`` and ``sea_state``, in the constructor for every episode or in the reset
-    options; :mod:`shipgym.envs.seaway`, off by default) the observations are formed from the
-    measured state (the wave-frequency motion added to heading, yaw rate and position), the
-    reward from the low-frequency one, and ``info`` adds ``wind``, ``sea_state``,
-    ``wave_motion`` and ``measured_state``.
+    options; :mod:`shipgym.models.seaway_options`, off by default) the observations are
+    formed from the measured state (the wave-frequency motion added to heading, yaw rate and
+    position), the reward from the low-frequency one, and ``info`` adds ``wind``,
+    ``sea_state``, ``wave_motion`` and ``measured_state``.
     Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
     range) as for ``RVGHeading-v0``, but positions (``x``, ``y`` and every waypoint's north
     and east) within +-6960 m, the distance covered in one episode at the top speed 8.7 m/s.

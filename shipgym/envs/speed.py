@@ -57,10 +57,10 @@ class RVGSpeedEnv(ShipEnv):
     ``initial_state``, ``setpoints`` (1 to 8 speeds [m/s]). ``info`` holds ``state``,
     the current, ``speed_error``, ``speed_setpoint`` and ``termination_reason``.
     At sea (``wind`` and ``sea_state``, in the constructor for every episode or in the reset
-    options; :mod:`shipgym.envs.seaway`, off by default) the observations are formed from the
-    measured state (the wave-frequency motion added to heading, yaw rate and position), the
-    reward from the low-frequency one, and ``info`` adds ``wind``, ``sea_state``,
-    ``wave_motion`` and ``measured_state``.
+    options; :mod:`shipgym.models.seaway_options`, off by default) the observations are
+    formed from the measured state (the wave-frequency motion added to heading, yaw rate and
+    position), the reward from the low-frequency one, and ``info`` adds ``wind``,
+    ``sea_state``, ``wave_motion`` and ``measured_state``.
     Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
     range) as for ``RVGHeading-v0``, from the top speed V = 8.7 m/s (``thrust_zero_speed``),
     but positions ``x``, ``y`` within +-3480 m (one episode at top speed) and ``setpoints`` in

@@ -61,10 +61,10 @@ class RVGTargetTrackingEnv(ShipEnv):
     ((north, east) in m and m/s), ``distance`` [m]. ``info`` holds ``state``, the current,
     ``distance``, ``distance_error`` and ``termination_reason``.
     At sea (``wind`` and ``sea_state``, in the constructor for every episode or in the reset
-    options; :mod:`shipgym.envs.seaway`, off by default) the observations are formed from the
-    measured state (the wave-frequency motion added to heading, yaw rate and position), the
-    reward from the low-frequency one, and ``info`` adds ``wind``, ``sea_state``,
-    ``wave_motion`` and ``measured_state``.
+    options; :mod:`shipgym.models.seaway_options`, off by default) the observations are
+    formed from the measured state (the wave-frequency motion added to heading, yaw rate and
+    position), the reward from the low-frequency one, and ``info`` adds ``wind``,
+    ``sea_state``, ``wave_motion`` and ``measured_state``.
     Option ranges (a value outside raises ``ValueError`` naming the option, the value and the
     range) as for ``RVGHeading-v0``, but positions (``x``, ``y`` and ``target_position``'s
     north and east) within +-6960 m (one episode at the top speed 8.7 m/s, or ``max_distance``

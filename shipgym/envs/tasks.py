@@ -7,7 +7,7 @@ the initial conditions with NumPy, for all rows being reset at once. The single 
 a batch of one, so the vector environment's sub-env ``i`` seeded with ``s + i`` reproduces the
 single environment seeded with ``s`` exactly, and autoresets of many sub-envs cost one pass.
 
-Wind and waves: ``wind`` and ``sea_state`` (:mod:`shipgym.envs.seaway`), in the env's
+Wind and waves: ``wind`` and ``sea_state`` (:mod:`shipgym.models.seaway_options`), in the env's
 constructor (:meth:`Task.set_seaway`) or ``reset(options=...)``; off by default. At sea a
 task's kernel forms the observations from the measured states ``xm`` (the states plus the
 wave-frequency motion, :mod:`shipgym.models.seaway`) and the rewards from the states.
@@ -48,16 +48,15 @@ from typing import Any, ClassVar
 import numpy as np
 
 from shipgym.envs import kernels
-from shipgym.envs import seaway as seaway_options
-from shipgym.envs.seaway import SeawayArrays
 from shipgym.envs.streams import RowStreams
-from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model
+from shipgym.models import NOMOTO_MODEL_NAMES, RVGParams, ShipModel, make_model, seaway_options
 from shipgym.models import seaway as sw
 from shipgym.models.angles import ssa
 from shipgym.models.delay import DelayLine
 from shipgym.models.integrate import NC
 from shipgym.models.model_file import is_model_file, load_model, model_info
 from shipgym.models.rvg import IPSI, IT1, IT2, IU, IV, IX, IY, LPP, SERVICE_SPEED
+from shipgym.models.seaway_options import SeawayArrays
 
 COMMON_OPTIONS = frozenset(
     {"current_speed", "current_direction", "initial_state", "wind", "sea_state"}
@@ -338,7 +337,7 @@ class Task:
 
     def set_seaway(self, wind: Any = None, sea_state: Any = None) -> None:
         """Set the wind and sea state of every episode (the env constructors' ``wind`` and
-        ``sea_state``; :mod:`shipgym.envs.seaway`); a reset's options override them.
+        ``sea_state``; :mod:`shipgym.models.seaway_options`); a reset's options override them.
 
         Raises
         ------

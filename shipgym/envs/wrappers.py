@@ -13,7 +13,11 @@ batch equals the wrapped single env Gymnasium's ``SyncVectorEnv`` would hold the
     *measured* state (:meth:`shipgym.envs.tasks.Task.observe`: the env's own kernel, so a
     heading error shifts the heading-error channel, a position error the cross-track error
     and the target's relative position); ``info["measured_state"]`` carries the measured
-    state for controllers that read states, ``info["state"]`` stays the truth.
+    state for controllers that read states, ``info["state"]`` stays the truth. At sea the
+    sensors measure the low-frequency motion plus the wave-frequency motion: the noise is
+    added to the env's own ``measured_state`` (the state with the wave-frequency motion), and
+    the observation is formed from the noisy state with the wave-frequency motion, as the env
+    forms it.
     :data:`SENSOR_NOISE` gives the default levels, typical of a ship's sensors: heading 0.5
     deg (gyrocompass), yaw rate 0.1 deg/s (rate-of-turn sensor), speed 0.1 m/s (speed log,
     GNSS), position 1 m (DGNSS). Each episode has its own noise generator,
@@ -99,15 +103,22 @@ class _NoiseModel:
         self.std = np.array([self.levels[k] for k, _ in used])
 
     def measure(
-        self, states: np.ndarray, rows: Sequence[int] | np.ndarray, draws: _NoiseDraws
-    ) -> np.ndarray:
-        """A copy of the true ``states`` ``(n, nx)`` with noise on ``rows``: each of them takes
-        its next standard normal per noisy state from its stream of ``draws``."""
-        measured = np.array(states, dtype=np.float64)
+        self, task: Task, rows: Sequence[int] | np.ndarray, draws: _NoiseDraws
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The states of ``task``'s ships with noise on ``rows`` (each of them takes its next
+        standard normal per noisy state from its stream of ``draws``): the true states
+        ``task.x`` with the noise (what the task's kernel observes: it adds the
+        wave-frequency motion itself) and the states as the sensors give them,
+        ``task.xm`` (the true states plus the wave-frequency motion at sea) with the same
+        noise, both ``(n, nx)`` copies."""
+        noisy = np.array(task.x, dtype=np.float64)
+        sensed = np.array(task.xm, dtype=np.float64)
         rows = np.asarray(rows, dtype=np.int64)
         if rows.size:
-            measured[np.ix_(rows, self.index)] += self.std * draws.next(rows)
-        return measured
+            noise = self.std * draws.next(rows)
+            noisy[np.ix_(rows, self.index)] += noise
+            sensed[np.ix_(rows, self.index)] += noise
+        return noisy, sensed
 
 
 class _NoiseDraws:
@@ -216,9 +227,8 @@ class SensorNoise(gym.Wrapper):
 
     def _measure(self, obs: np.ndarray, info: dict[str, Any]) -> tuple[np.ndarray, dict]:
         task = self.env.unwrapped.task
-        measured = self._noise.measure(task.x, [0], self._draws)
-        noisy = task.observe(measured)[0].astype(obs.dtype)
-        return noisy, {**info, "measured_state": measured[0]}
+        noisy, measured = self._noise.measure(task, [0], self._draws)
+        return task.observe(noisy)[0].astype(obs.dtype), {**info, "measured_state": measured[0]}
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -279,8 +289,8 @@ class VectorSensorNoise(VectorWrapper):
         """The noisy observations (``rows`` measured anew, the others as they were) and the
         info with the measured states of ``rows``."""
         task = self.env.unwrapped.task
-        measured = self._noise.measure(task.x, rows, self._draws)
-        self._obs[rows] = task.observe(measured)[rows]
+        noisy, measured = self._noise.measure(task, rows, self._draws)
+        self._obs[rows] = task.observe(noisy)[rows]
         flags = np.zeros(self.num_envs, dtype=np.bool_)
         flags[rows] = True
         measured[~flags] = 0.0

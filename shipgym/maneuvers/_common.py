@@ -8,11 +8,13 @@ copied), held until steady by :func:`hold_until_steady`, and recorded as a
 :class:`TimeSeries`. A model-test ship of any length (``kvlcc2``, ``vmm``) gets the rig of the
 7 m KVLCC2 Froude-scaled (times by ``sqrt(L / 7 m)``, yaw rates by its inverse).
 
-A trial in wind (``wind``, the env's ``wind`` option of :mod:`shipgym.envs.seaway` with one
-speed and direction) runs the same physics as the envs: the Nomoto family (the Mariner) and the
-R/V Gunnerus through the seaway's load (:func:`shipgym.models.seaway.seaway_block` on a
-:class:`~shipgym.envs.seaway.SeawayArrays` of the trial's ship, the load of each step from the
-state at its start, :meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>`'s ``load``),
+A trial in wind (``wind``, the env's ``wind`` option of :mod:`shipgym.models.seaway_options`
+with one speed and direction) runs the same physics as the envs: the Nomoto family (the
+Mariner) and the R/V Gunnerus through the seaway's load
+(:func:`shipgym.models.seaway.seaway_block` on a
+:class:`~shipgym.models.seaway_options.SeawayArrays` of the trial's ship, the load of each step
+from the state at its start,
+:meth:`ShipModel.simulate <shipgym.models.ShipModel.simulate>`'s ``load``),
 ``kvlcc2`` through its MMG model's wind (``MMGParams.wind_speed``, ``wind_direction``) and a
 ``vmm`` with identified wind terms through its apparent-wind inputs
 (:func:`shipgym.models.wind.apparent_wind` of the state at the start of each step). The wind
@@ -33,12 +35,12 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.envs.seaway import N_DRAWS, SeawayArrays, Wind, wind_option
 from shipgym.maneuvers.particulars import PARTICULARS, ShipParticulars
 from shipgym.models import MODEL_NAMES, NOMOTO_MODEL_NAMES, ShipModel, SimulationResult, make_model
 from shipgym.models import seaway as sw
 from shipgym.models.integrate import NC
 from shipgym.models.model_file import is_model_file, model_info
+from shipgym.models.seaway_options import N_DRAWS, SeawayArrays, Wind, wind_option
 from shipgym.models.vmm import FACTORS
 from shipgym.models.wind import apparent_wind
 
@@ -72,10 +74,10 @@ _WIND_FACTORS = [FACTORS.index(f) for f in ("wc", "ws", "w2")]
 def trial_wind(wind: Mapping[str, Any] | None) -> Wind | None:
     """The checked wind of a trial, or None (calm air).
 
-    ``wind`` is the env's ``wind`` option (:func:`shipgym.envs.seaway.wind_option`): ``speed``
-    [m/s] and ``direction`` (where the wind comes FROM [rad], clockwise from north), both one
-    number here (a trial draws nothing), and ``gusts`` (default False in a trial: a constant
-    true wind is what the trial correction assumes).
+    ``wind`` is the env's ``wind`` option (:func:`shipgym.models.seaway_options.wind_option`):
+    ``speed`` [m/s] and ``direction`` (where the wind comes FROM [rad], clockwise from north),
+    both one number here (a trial draws nothing), and ``gusts`` (default False in a trial: a
+    constant true wind is what the trial correction assumes).
     """
     if wind is None:
         return None

@@ -19,7 +19,6 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
-from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import crossing, side_sign, value_at, wind_text
 from shipgym.maneuvers.imo import IMOReport
 from shipgym.maneuvers.particulars import ShipParticulars
@@ -27,6 +26,7 @@ from shipgym.maneuvers.pullouts import PullOutResult
 from shipgym.maneuvers.spirals import SpiralResult
 from shipgym.maneuvers.turning import TurningResult
 from shipgym.maneuvers.zigzags import ZigZagResult
+from shipgym.models.seaway_options import Wind
 
 __all__ = ["plot_imo", "plot_pullout", "plot_spiral", "plot_turning_circle", "plot_zigzag"]
 

@@ -14,7 +14,6 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -27,6 +26,7 @@ from shipgym.maneuvers._common import (
     wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
+from shipgym.models.seaway_options import Wind
 
 __all__ = ["PullOutResult", "pullout"]
 

@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -36,6 +35,7 @@ from shipgym.maneuvers._common import (
     wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
+from shipgym.models.seaway_options import Wind
 
 __all__ = ["InitialTurningResult", "TurningResult", "initial_turning", "turning_circle"]
 
@@ -193,7 +193,7 @@ def turning_circle(
     wind : dict, optional
         A constant true wind from the first execute on: ``speed`` [m/s], ``direction`` (where
         it comes FROM [rad], clockwise from north) and ``gusts`` (default False), the env's
-        ``wind`` option (:mod:`shipgym.envs.seaway`); its drift over the steady turn is
+        ``wind`` option (:mod:`shipgym.models.seaway_options`); its drift over the steady turn is
         :attr:`TurningResult.drift`. For the Nomoto family (the Mariner), ``rvg3dof``,
         ``kvlcc2`` and a ``vmm`` with identified wind terms.
 

@@ -19,7 +19,6 @@ from typing import Any
 
 import numpy as np
 
-from shipgym.envs.seaway import Wind
 from shipgym.maneuvers._common import (
     ModelLike,
     Rig,
@@ -31,6 +30,7 @@ from shipgym.maneuvers._common import (
     wind_json,
 )
 from shipgym.maneuvers.particulars import ShipParticulars
+from shipgym.models.seaway_options import Wind
 
 __all__ = ["ZigZagResult", "zigzag"]
 

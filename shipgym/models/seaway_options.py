@@ -1,5 +1,6 @@
-"""The seaway of an environment's batch: the ``wind`` and ``sea_state`` options, their ranges
-and draws, and the per-ship arrays the task kernels step (:mod:`shipgym.models.seaway`).
+"""The seaway of a batch of ships (an environment's sub-envs, a manoeuvre's ship): the ``wind``
+and ``sea_state`` options, their ranges and draws, and the per-ship arrays that the compiled
+step of :mod:`shipgym.models.seaway` advances.
 
 Options (of the env's constructor, for every episode, and of ``reset(options=...)``, for the
 episodes of that reset; ``None`` turns a part off; both off by default)
