@@ -505,7 +505,7 @@ def mmg_row(x, u, p, c, out):
 @kernel
 def _straight_surge_acceleration(u, n, p):  # pragma: no cover - jit
     """``u'`` [m/s^2] of :func:`mmg_row` running straight at ``u`` with the propeller at ``n``
-    and the rudder amidships, in calm water."""
+    and the rudder amidships, in the wind of ``p`` (none: calm water)."""
     x = np.zeros(7)
     x[IU] = u
     inputs = np.array([0.0, n])
