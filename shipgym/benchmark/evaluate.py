@@ -15,7 +15,10 @@ env stepped episode after episode. An error raised in an episode becomes an
 :class:`EpisodeError` naming the env, controller, condition and seed. Metrics (means
 over episodes):
 
-* heading envs: ``heading_rms_deg`` (RMS heading error over the whole episode),
+* heading envs: ``heading_rms_deg`` (RMS heading error over the whole episode, of the
+  heading as measured: at sea with the wave-frequency motion), ``lf_heading_rms_deg`` (the
+  same of the ship's low-frequency heading, ``info["state"]``: what the autopilot is to hold
+  at sea; in calm water the two are the same),
   ``overshoot_deg`` (largest excursion past a new setpoint, in the direction of the change,
   over the setpoint segments of an episode), ``actuator_rms`` (RMS of the normalised command);
 * speed env: ``speed_rms_m_s``;
@@ -68,16 +71,17 @@ from shipgym.benchmark.stats import bootstrap_ci
 from shipgym.envs import ENV_IDS, env_task
 from shipgym.envs.kernels import BLOW_UP as _BLOW_UP_CODE
 from shipgym.envs.kernels import REASONS
+from shipgym.models import ssa
 
 #: Termination reason of an episode whose state stopped being finite.
 BLOW_UP = REASONS[_BLOW_UP_CODE]
 
 _WEAR = ("rudder_travel_deg_min", "rudder_reversals_min")
 _TASK_METRICS: dict[str, tuple[str, ...]] = {
-    "NomotoHeading": ("heading_rms_deg", "overshoot_deg", "settling_time_s", "steady_state_deg",
-                      "actuator_rms", *_WEAR),
-    "RVGHeading": ("heading_rms_deg", "overshoot_deg", "settling_time_s", "steady_state_deg",
-                   "actuator_rms", *_WEAR, "energy_mj"),
+    "NomotoHeading": ("heading_rms_deg", "lf_heading_rms_deg", "overshoot_deg", "settling_time_s",
+                      "steady_state_deg", "actuator_rms", *_WEAR),
+    "RVGHeading": ("heading_rms_deg", "lf_heading_rms_deg", "overshoot_deg", "settling_time_s",
+                   "steady_state_deg", "actuator_rms", *_WEAR, "energy_mj"),
     "RVGSpeed": ("speed_rms_m_s", "settling_time_s", "steady_state_m_s", "energy_mj"),
     "RVGPathFollowing": ("cross_track_rms_m", "cross_track_final_m", "cross_track_straight_m",
                          "completed", *_WEAR, "energy_mj"),
@@ -149,8 +153,9 @@ class EpisodeLog:
     reward : ndarray, shape (L,)
         Reward of each step.
     signals : dict of str to ndarray
-        Every scalar entry of the step ``info`` (the task metrics, the current) over the
-        episode, shape (L,).
+        Every entry of the step ``info`` but the states (the task metrics, the current; at
+        sea the wind, sea state and wave motion) over the episode, shape (L,) for a number,
+        (L, k) for an entry of k numbers.
     termination_reason : str
         How the episode ended (``info["termination_reason"]`` of its last step).
     reset_info : dict
@@ -364,10 +369,13 @@ def episode_metrics(env_id: str, log: EpisodeLog, dt: float) -> dict[str, float]
         extra["energy_mj"] = _rvg_energy_mj(states, dt)
     if env_id in HEADING_ENVS:
         e = log.signal("heading_error")
+        setpoint = log.signal("heading_setpoint")
+        lf = ssa(setpoint - states[:, 2])  # the LF heading (psi is state 2 of every model)
         a = np.asarray(log.action, dtype=float)
-        settle, ss = _settling(e, log.signal("heading_setpoint"), HEADING_BAND, dt)
+        settle, ss = _settling(e, setpoint, HEADING_BAND, dt)
         out = {
             "heading_rms_deg": math.degrees(float(np.sqrt(np.mean(e**2)))),
+            "lf_heading_rms_deg": math.degrees(float(np.sqrt(np.mean(lf**2)))),
             "overshoot_deg": _overshoot_deg(log),
             "settling_time_s": settle,
             "steady_state_deg": math.degrees(ss),
@@ -569,7 +577,10 @@ def _rollout(
     states = np.empty((n, steps, x0.shape[1]))
     actions = np.empty((n, steps, actor.act_dim), dtype=np.float32)
     rewards = np.empty((n, steps))
-    signals = {k: np.empty((n, steps), dtype=np.asarray(info[k]).dtype) for k in keys}
+    signals = {  # a scalar per row, or a row per row (the seaway's wind, sea state, wave motion)
+        k: np.empty((n, steps, *np.shape(info[k])[1:]), dtype=np.asarray(info[k]).dtype)
+        for k in keys
+    }
     targets = np.empty((n, steps, 2)) if hasattr(task, "target") else None
     alive = np.ones(n, dtype=np.bool_)
     lengths = np.zeros(n, dtype=np.int64)

@@ -119,6 +119,7 @@ def episode_figures(
 #: One colour per controller, the same in every benchmark figure.
 CONTROLLER_COLOURS = {
     "classic": "#7fa7d6",
+    "classic-wf": "#e67e22",
     "classic-tuned": "#1f5fa8",
     "ppo": "#c0392b",
     "sac": "#2e8b57",
@@ -253,6 +254,48 @@ def plot_benchmark_robustness(benchmark: Any, path: str | Path) -> Path:
     axes[0].set_ylabel("mean return (95 % interval); x: blew up, no mean")
     axes[0].legend(fontsize=7)
     fig.suptitle("robustness: the same seeds in every condition", fontsize=11)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    return path
+
+
+def plot_seaway(entries: list[dict[str, Any]], path: str | Path) -> Path:
+    """The seaway condition against calm water, one row per env: the low-frequency heading
+    error (path following: the cross-track error) and the rudder (azimuth) travel of each
+    controller, calm and at sea side by side, mean and bootstrap 95 % interval
+    (:func:`shipgym.benchmark.report.seaway_rows` gives the numbers)."""
+    from shipgym.benchmark.report import seaway_error_key, seaway_rows
+
+    envs = list(dict.fromkeys(e["env"] for e in entries if e["condition"] == "seaway"))
+    fig = Figure(figsize=(11, 3.1 * len(envs)), constrained_layout=True)
+    FigureCanvasAgg(fig)
+    axes = np.atleast_2d(fig.subplots(len(envs), 2, squeeze=False))
+    for row, env_id in zip(axes, envs, strict=True):
+        rows = seaway_rows(entries, env_id)
+        names = [r["controller"] for r in rows]
+        x = np.arange(len(names))
+        for ax, key, label in (
+            (row[0], seaway_error_key(env_id), None),
+            (row[1], "rudder_travel_deg_min", "rudder travel [deg/min], log scale"),
+        ):
+            for shift, cond, hatch in ((-0.2, "calm", ""), (0.2, "seaway", "//")):
+                stats = [r[cond].get(key) if r[cond] else None for r in rows]
+                mean = np.array([s[0] if s else np.nan for s in stats])
+                err = np.array([[s[0] - s[1] if s else 0.0 for s in stats],
+                                [s[2] - s[0] if s else 0.0 for s in stats]])  # fmt: skip
+                ax.bar(x + shift, mean, 0.4, yerr=err, capsize=2, hatch=hatch,
+                       color=[_colour(n) for n in names], edgecolor="0.25", label=cond)  # fmt: skip
+            ax.set_xticks(x, names, fontsize=8)
+            ax.set_title(f"{env_id.split('/')[-1]}: {label or key}", fontsize=9)
+            ax.grid(axis="y", alpha=0.3)
+        row[1].set_yscale("log")
+        row[0].legend(fontsize=8, title="plain: calm, hatched: at sea", title_fontsize=7)
+    fig.suptitle(
+        "seaway condition (H_s 2.0 m, wind 9.5 m/s, directions drawn per episode) against "
+        "calm water; classic-wf: classic with the wave filter (calm: classic's bar)",
+        fontsize=10,
+    )
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)

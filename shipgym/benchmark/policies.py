@@ -37,6 +37,15 @@ agents the same way. Its few design parameters (:attr:`DESIGN` of each class) co
 RL training seeds (:mod:`shipgym.benchmark.tuning`); the chosen values and the search's record
 ship in ``shipgym/benchmark/tuned/``.
 
+``classic-wf``: the ``classic`` controllers with a wave filter in their heading loop
+(``wave_filter=True`` of the classic policies, :class:`HeadingWaveFilter`): at sea the
+autopilot (and the path and target guidance) gets the filter's low-frequency heading and yaw
+rate instead of the measured ones, which carry the wave-frequency motion. The filter is
+:class:`controllers.WaveFilter` on the first-order Nomoto model the autopilot is designed on,
+tuned per ship by Fossen's rule from the sea state in ``info``; a ship in calm water gets the
+measured heading unchanged. The speed autopilot has no heading loop: there ``classic-wf`` is
+``classic``.
+
 ``classic`` with a gains file (``make_policy(..., gains=FILE)``, ``shipgym evaluate --gains``;
 NomotoHeading only): the same autopilot with exactly the gains, reference model, limits and
 offset of a gains document that ``shipgym design MODEL.json --json FILE`` wrote for an
@@ -58,6 +67,7 @@ from controllers import (
     ConstantBearingGuidance,
     HeadingAutopilot,
     SpeedAutopilot,
+    WaveFilter,
     course_and_speed,
     design_model,
     linearised_drag_model,
@@ -69,6 +79,8 @@ from shipgym.envs import ENV_IDS, env_task
 from shipgym.models import make_model
 from shipgym.models.model_file import is_model_file
 from shipgym.models.rvg import IA1, IA2, IR, IT1, IT2, IU, IV, LPP, SERVICE_SPEED, RVGParams
+from shipgym.models.seaway import GAIN_ANGLES, MIN_ENCOUNTER_FREQUENCY, wave_motion_gains
+from shipgym.models.waves import SeaState, encounter_angle, encounter_frequency
 
 
 @cache
@@ -109,12 +121,19 @@ def nomoto_heading_autopilot(
     (:func:`controllers.design_model`; the bandwidth from the steering gear and the ship
     unless ``omega_n`` is given), damping ``zeta``, reference model at ``reference_ratio``
     times the bandwidth (0: none)."""
-    K, T1, T2, T3, n1 = nomoto_linear_yaw(model)
     limits = steering_limits(model)
-    K, T, omega = design_model(K, T1, T2, T3, n1=n1, omega=omega_n, **limits)
+    K, T, omega = nomoto_design_model(model, omega_n)
     return HeadingAutopilot.from_nomoto(
         K, T, dt, omega_n=omega, zeta=zeta, reference_omega=reference_ratio * omega, **limits
     )
+
+
+def nomoto_design_model(model: Any, omega_n: float | None = None) -> tuple[float, float, float]:
+    """``(K, T, omega_n)``: the first-order Nomoto model of a Nomoto-family ship that matches
+    its linear yaw response at the design bandwidth (:func:`controllers.design_model`; the
+    bandwidth from the steering gear and the ship unless ``omega_n`` is given)."""
+    K, T1, T2, T3, n1 = nomoto_linear_yaw(model)
+    return design_model(K, T1, T2, T3, n1=n1, omega=omega_n, **steering_limits(model))
 
 
 def nomoto_linear_yaw(model: Any) -> tuple[float, float, float, float, float]:
@@ -214,6 +233,116 @@ def _rows(info: dict[str, Any]) -> dict[str, Any]:
     return {key: np.asarray(value)[None] for key, value in info.items()}
 
 
+#: Steps of the wave filter's gain schedule: a ship's filter is designed anew when its
+#: encounter peak frequency moves by a step of 5 % or its expected WF heading by one of 10 %
+#: (the designs are kept, so a ship back on an old course costs nothing).
+SCHEDULE_FREQUENCY_STEP = math.log(1.05)
+SCHEDULE_STD_STEP = math.log(1.1)
+#: Least WF heading standard deviation [rad] the filter is designed for (head and following
+#: seas turn the ship little: the filter then passes the heading nearly unchanged).
+MIN_WAVE_HEADING_STD = math.radians(0.02)
+
+
+@cache
+def _yaw_gains(height: float, period: float, length: float) -> np.ndarray:
+    """Signed RMS WF yaw per metre of ``H_s / 4`` over :data:`GAIN_ANGLES` (JONSWAP, gamma
+    3.3) of a ship of length ``length`` [m]."""
+    return wave_motion_gains(SeaState(height, period, 0.0), length)[1]
+
+
+class HeadingWaveFilter:
+    """The wave filter of a classic heading loop: :class:`controllers.WaveFilter` on the
+    first-order Nomoto model ``K, T`` the autopilot is designed on, one wave model per ship.
+
+    Design rule (Fossen 2021, section 13.3): the wave model's frequency is the encounter peak
+    frequency ``omega_e = |omega_p - omega_p^2 U cos(beta) / g|`` (at least
+    :data:`~shipgym.models.seaway.MIN_ENCOUNTER_FREQUENCY`) of the sea state in ``info``
+    (``omega_p = 2 pi / T_p``, the direction the waves travel to) at the ship's estimated
+    LF heading and measured speed through the water ``U``; its standard deviation the WF
+    heading expected there, ``H_s / 4`` times the ship's RMS yaw per metre
+    (:func:`~shipgym.models.seaway.wave_motion_gains`, JONSWAP with gamma 3.3) at the
+    encounter angle ``beta`` (at least :data:`MIN_WAVE_HEADING_STD`); damping 0.1. The design
+    is gain-scheduled on the ship's heading and speed (:data:`SCHEDULE_FREQUENCY_STEP`,
+    :data:`SCHEDULE_STD_STEP`). A ship with no waves (``H_s = 0``, or no ``sea_state`` in
+    ``info``) gets its measured heading and yaw rate unchanged.
+
+    Parameters
+    ----------
+    K, T : float
+        The Nomoto model [1/s, s] from the rudder (the pods' common azimuth) to yaw rate.
+    dt : float
+        Control step [s].
+    length : float
+        The ship's waterline length [m] (its yaw in waves).
+    """
+
+    def __init__(self, K: float, T: float, dt: float, length: float) -> None:
+        self.K, self.T, self.dt, self.length = K, T, dt, length
+        self.filter: WaveFilter | None = None
+
+    def _design(self, psi: np.ndarray, speed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each ship's schedule indices (frequency, standard deviation) at heading ``psi``
+        and speed ``speed``."""
+        beta = encounter_angle(self.direction, psi)
+        omega = np.maximum(
+            np.abs(encounter_frequency(self.peak, speed, beta)), MIN_ENCOUNTER_FREQUENCY
+        )
+        std = np.array([
+            abs(np.interp(b, GAIN_ANGLES, _yaw_gains(h, t, self.length))) * h / 4.0
+            for b, h, t in zip(beta, self.height, self.period, strict=True)
+        ])  # fmt: skip
+        return (
+            np.round(np.log(omega) / SCHEDULE_FREQUENCY_STEP),
+            np.round(np.log(np.maximum(std, MIN_WAVE_HEADING_STD)) / SCHEDULE_STD_STEP),
+        )
+
+    def _retune(self, psi: np.ndarray, speed: np.ndarray) -> None:
+        """Design the filters of the ships at sea whose schedule step changed."""
+        assert self.filter is not None
+        f_idx, s_idx = self._design(psi, speed)
+        changed = self.at_sea & ((f_idx != self.schedule[0]) | (s_idx != self.schedule[1]))
+        if changed.any():
+            rows = np.flatnonzero(changed)
+            self.filter.retune(
+                rows,
+                np.exp(f_idx[rows] * SCHEDULE_FREQUENCY_STEP),
+                np.exp(s_idx[rows] * SCHEDULE_STD_STEP),
+            )
+            self.schedule[0][rows], self.schedule[1][rows] = f_idx[rows], s_idx[rows]
+
+    def reset(
+        self, info: dict[str, Any], psi: np.ndarray, r: np.ndarray, speed: np.ndarray
+    ) -> None:
+        """Start the episodes of every ship: the sea state of each from ``info``, the
+        estimates at the measured heading ``psi`` and yaw rate ``r``."""
+        n = len(psi)
+        sea = np.asarray(info.get("sea_state", np.zeros((n, 3))), dtype=float)
+        self.height, self.period, self.direction = sea[:, 0], sea[:, 1], sea[:, 2]
+        self.at_sea = self.height > 0.0
+        if not self.at_sea.any():
+            self.filter = None
+            return
+        self.peak = 2.0 * math.pi / np.where(self.at_sea, self.period, 2.0 * math.pi)
+        self.filter = WaveFilter(
+            self.K, self.T, self.dt, np.ones(n), np.full(n, MIN_WAVE_HEADING_STD)
+        )
+        self.schedule = (np.full(n, np.nan), np.full(n, np.nan))
+        self._retune(psi, speed)
+        self.filter.reset(psi, r)
+
+    def update(
+        self, psi: np.ndarray, r: np.ndarray, rudder: np.ndarray, speed: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The LF heading and yaw rate of every ship from its measured heading ``psi``, yaw
+        rate ``r`` (passed through for ships in calm water), the rudder ``rudder`` [rad] it
+        held over the step just ended and its speed through the water ``speed`` [m/s]."""
+        if self.filter is None:
+            return psi, r
+        psi_f, r_f = self.filter.update(psi, rudder)
+        self._retune(psi_f, speed)
+        return np.where(self.at_sea, psi_f, psi), np.where(self.at_sea, r_f, r)
+
+
 class ZeroPolicy:
     """The neutral command: rudder or azimuth amidships, half the thrust range (action 0)."""
 
@@ -243,6 +372,9 @@ class ClassicPolicy:
         The nominal ship the controller is designed on: a Nomoto-family model name for the
         Nomoto env, an RVG parameter set name (``"seed001"``, ``"sea_trials"``) for the
         Gunnerus envs.
+    wave_filter : bool
+        Feed the heading loop the low-frequency heading and yaw rate of a
+        :class:`HeadingWaveFilter` instead of the measured ones (``classic-wf``).
     **design : float
         Values for some of :attr:`DESIGN` (the rest keep their design-rule values).
     """
@@ -252,7 +384,9 @@ class ClassicPolicy:
     #: Default nominal ship.
     NOMINAL: ClassVar[str] = "seed001"
 
-    def __init__(self, nominal: str | None = None, **design: float | None) -> None:
+    def __init__(
+        self, nominal: str | None = None, *, wave_filter: bool = False, **design: float | None
+    ) -> None:
         unknown = sorted(set(design) - set(self.DESIGN))
         if unknown:
             raise ValueError(
@@ -264,6 +398,48 @@ class ClassicPolicy:
                 raise ValueError(f"design parameter {key} must be a finite number, got {value!r}")
         self.nominal = nominal or self.NOMINAL
         self.design: dict[str, Any] = {**self.DESIGN, **design}
+        self.wave_filter = bool(wave_filter)
+        self.filter: HeadingWaveFilter | None = None
+
+    def _start_filter(
+        self, env: Any, info: dict[str, Any], K: float, T: float, psi: np.ndarray,
+        r: np.ndarray, speed: np.ndarray,
+    ) -> None:  # fmt: skip
+        """Make and start the heading loop's wave filter (if :attr:`wave_filter`) on the
+        Nomoto model ``K, T``, for the ships of ``env``'s task."""
+        if not self.wave_filter:
+            self.filter = None
+            return
+        task = env.task
+        length = task.seaway_ship().length if task.seaway_ship is not None else 1.0
+        self.filter = HeadingWaveFilter(K, T, task.dt, length)
+        self.filter.reset(info, psi, r, speed)
+
+    def _filtered(
+        self, psi: np.ndarray, r: np.ndarray, rudder: np.ndarray, speed: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The heading and yaw rate the heading loop gets: the wave filter's estimates, or
+        the measured ones without a filter."""
+        if self.filter is None:
+            return psi, r
+        return self.filter.update(psi, r, rudder, speed)
+
+    def _start_rvg_filter(self, env: Any, info: dict[str, Any], state: np.ndarray) -> None:
+        """:meth:`_start_filter` of a Gunnerus heading loop: the Nomoto model of the nominal
+        parameter set (:func:`rvg_heading_nomoto`), the pods' common azimuth as the rudder."""
+        if self.wave_filter:
+            K, T = rvg_heading_nomoto(params=self.nominal)
+            speed = _speed_through_water(state, info["current_speed"], info["current_direction"])
+            self._start_filter(env, info, K, T, state[:, 2], state[:, IR], speed)
+
+    def _rvg_filtered(self, info: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+        """The heading and yaw rate a Gunnerus heading loop gets (:meth:`_filtered`)."""
+        state = _measured(info)
+        if self.filter is None:
+            return state[:, 2], state[:, IR]
+        azimuth = 0.5 * (state[:, IA1] + state[:, IA2])
+        speed = _speed_through_water(state, info["current_speed"], info["current_direction"])
+        return self._filtered(state[:, 2], state[:, IR], azimuth, speed)
 
     def reset(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
         """Start an episode of one ship (a single env): a batch of one."""
@@ -300,25 +476,34 @@ class NomotoHeadingClassic(ClassicPolicy):
         self.max_angle = model.gear.max_angle
         self.dt = env.task.dt
         self.ipsi, self.ir = model.index("psi"), model.index("r")
+        self.iu, self.idelta = model.index("U"), model.index("delta")
         self.pilot = self._autopilot(model, self.dt)
         state = _measured(info)
-        self.pilot.reset(state[:, self.ipsi], state[:, self.ir], t=0.0)
+        psi, r = state[:, self.ipsi], state[:, self.ir]
+        self.pilot.reset(psi, r, t=0.0)
+        if self.wave_filter:
+            K, T, _ = nomoto_design_model(self._nominal(model), self.design["omega_n"])
+            self._start_filter(env, info, K, T, psi, r, state[:, self.iu])
         self.t = 0.0
 
-    def _autopilot(self, model: Any, dt: float) -> HeadingAutopilot:
-        """The design rule on the nominal ship (with the env's gear and speed)."""
-        nominal = (
+    def _nominal(self, model: Any) -> Any:
+        """The nominal ship (with the env's gear and speed)."""
+        return (
             make_model(self.nominal)  # an identified ship: its own gear, speed and delay
             if is_model_file(self.nominal)
             else make_model(self.nominal, gear=model.gear, surge=model.surge)
         )
-        return nomoto_heading_autopilot(nominal, dt, **self.design)
+
+    def _autopilot(self, model: Any, dt: float) -> HeadingAutopilot:
+        """The design rule on the nominal ship (with the env's gear and speed)."""
+        return nomoto_heading_autopilot(self._nominal(model), dt, **self.design)
 
     def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        delta = self.pilot.update(
-            self.t, state[:, self.ipsi], state[:, self.ir], info["heading_setpoint"]
+        psi, r = self._filtered(
+            state[:, self.ipsi], state[:, self.ir], state[:, self.idelta], state[:, self.iu]
         )
+        delta = self.pilot.update(self.t, psi, r, info["heading_setpoint"])
         self.t += self.dt
         return (delta / self.max_angle).astype(np.float32)[:, None]
 
@@ -517,11 +702,12 @@ class RVGHeadingClassic(ClassicPolicy):
         self.pilot = _rvg_heading_autopilot(self.dt, self.max_azimuth, self.nominal, **self.design)
         state = _measured(info)
         self.pilot.reset(state[:, 2], state[:, IR], t=0.0)
+        self._start_rvg_filter(env, info, state)
         self.t = 0.0
 
     def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        state = _measured(info)
-        azimuth = self.pilot.update(self.t, state[:, 2], state[:, IR], info["heading_setpoint"])
+        psi, r = self._rvg_filtered(info)
+        azimuth = self.pilot.update(self.t, psi, r, info["heading_setpoint"])
         self.t += self.dt
         return pod_env_actions(azimuth, 0.0, "heading", max_azimuth=self.max_azimuth)
 
@@ -561,8 +747,15 @@ class RVGPathClassic(ClassicPolicy):
         "lookahead_lengths": 3.0, "omega_n": None, "reference_omega": 0.3, "max_turn_rate": 0.04,
     }  # fmt: skip
 
-    def __init__(self, nominal: str | None = None, integral: bool = True, **design: float | None):
-        super().__init__(nominal, **design)
+    def __init__(
+        self,
+        nominal: str | None = None,
+        integral: bool = True,
+        *,
+        wave_filter: bool = False,
+        **design: float | None,
+    ) -> None:
+        super().__init__(nominal, wave_filter=wave_filter, **design)
         self.integral = integral
 
     def reset_vector(self, env: Any, obs: np.ndarray, info: dict[str, Any]) -> None:
@@ -583,11 +776,12 @@ class RVGPathClassic(ClassicPolicy):
         state = _measured(info)
         self.heading.reset(state[:, 2], state[:, IR], t=0.0)
         self.speed.reset(t=0.0, integral=np.zeros(len(obs)))
+        self._start_rvg_filter(env, info, state)
         self.t = 0.0
 
     def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        psi, r = state[:, 2], state[:, IR]
+        psi, r = self._rvg_filtered(info)
         chi_d = self.guidance.update(self.t, state[:, :2], psi, r)
         azimuth = self.heading.update(self.t, psi, r, chi_d)
         through_water = _speed_through_water(
@@ -633,11 +827,12 @@ class RVGTargetClassic(ClassicPolicy):
         state = _measured(info)
         self.heading.reset(state[:, 2], state[:, IR], t=0.0)
         self.speed.reset(t=0.0, integral=np.zeros(len(obs)))
+        self._start_rvg_filter(env, info, state)
         self.t = 0.0
 
     def act_vector(self, obs: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         state = _measured(info)
-        psi = state[:, 2]
+        psi, r = self._rvg_filtered(info)
         c, s = np.cos(psi), np.sin(psi)
 
         def to_ned(a: np.ndarray, b: np.ndarray) -> np.ndarray:  # body frame -> NED, (n, 2)
@@ -654,7 +849,7 @@ class RVGTargetClassic(ClassicPolicy):
         # that course with the measured sideslip (current, drift), and hold the ground speed
         course, speed = course_and_speed(ship_velocity)
         crab = course - psi
-        azimuth = self.heading.update(self.t, psi, state[:, IR], chi_d - crab)
+        azimuth = self.heading.update(self.t, psi, r, chi_d - crab)
         thrust = self.speed.update(self.t, speed, u_d)
         self.t += self.dt
         return pod_env_actions(azimuth, thrust, "target", max_azimuth=self.max_azimuth)
@@ -670,9 +865,9 @@ CLASSIC: dict[str, type[ClassicPolicy]] = {
 }
 
 #: Names accepted by ``shipgym evaluate --controller``: the classic controller with its
-#: design-rule gains and with its tuned gains, the trained PPO and SAC agents
-#: (:mod:`shipgym.rl.agents`) and the neutral command.
-POLICIES = ("classic", "classic-tuned", "ppo", "sac", "zero")
+#: design-rule gains, with them and a wave filter in its heading loop, and with its tuned
+#: gains, the trained PPO and SAC agents (:mod:`shipgym.rl.agents`) and the neutral command.
+POLICIES = ("classic", "classic-wf", "classic-tuned", "ppo", "sac", "zero")
 
 
 def nominal_ship(env_id: str) -> str:
@@ -683,10 +878,15 @@ def nominal_ship(env_id: str) -> str:
     return str(kwargs.get("params", "seed001"))
 
 
-def classic_policy(env_id: str, ship: str | None = None, **design: float | None) -> ClassicPolicy:
+def classic_policy(
+    env_id: str, ship: str | None = None, *, wave_filter: bool = False, **design: float | None
+) -> ClassicPolicy:
     """The classic policy of ``env_id`` designed on ``ship`` (default: its nominal ship) with
-    design parameters ``design`` (the rest at their design-rule values)."""
-    return CLASSIC[env_task(env_id)](ship or nominal_ship(env_id), **design)
+    design parameters ``design`` (the rest at their design-rule values), with a wave filter
+    in its heading loop if ``wave_filter``."""
+    return CLASSIC[env_task(env_id)](
+        ship or nominal_ship(env_id), wave_filter=wave_filter, **design
+    )
 
 
 def make_policy(
@@ -727,6 +927,8 @@ def make_policy(
         return ZeroPolicy()
     if name == "classic":
         return classic_policy(env_id, model)
+    if name == "classic-wf":
+        return classic_policy(env_id, model, wave_filter=True)
     if name == "classic-tuned":
         from shipgym.benchmark.tuning import load_tuned
 

@@ -195,6 +195,85 @@ def paired_table(entries: Sequence[dict[str, Any]], reference: str = REFERENCE) 
     ]
 
 
+def seaway_error_key(env_id: str) -> str:
+    """The error metric the seaway table shows for ``env_id``: the low-frequency heading error
+    of the heading tasks, else the task's first metric (cross-track, speed, distance)."""
+    from shipgym.benchmark.evaluate import METRICS
+
+    keys = METRICS[env_id]
+    return "lf_heading_rms_deg" if "lf_heading_rms_deg" in keys else keys[0]
+
+
+#: The columns of the seaway table besides the error: what the sea costs the steering gear.
+SEAWAY_KEYS = ("heading_rms_deg", "rudder_travel_deg_min", "rudder_reversals_min", "energy_mj")
+
+
+def seaway_rows(entries: Sequence[dict[str, Any]], env_id: str) -> list[dict[str, Any]]:
+    """Per controller of ``env_id``'s seaway condition: ``calm`` and ``seaway``, each a dict
+    of ``key -> (mean, low, high)`` (bootstrap 95 % interval) for the return and the metrics,
+    or None where that condition was not run. ``classic-wf``'s calm values are ``classic``'s
+    (the wave filter passes a calm sea's heading through unchanged)."""
+    by_key = {(e["env"], e["controller"], e["condition"]): e for e in entries}
+
+    def stats(e: dict[str, Any] | None) -> dict[str, tuple[float, float, float]] | None:
+        if e is None or _blew_up(e):
+            return None
+        out = {"return": (e["mean_return"], *(e.get("return_ci95") or [e["mean_return"]] * 2))}
+        for k, m in e["metrics"].items():
+            out[k] = (m, *(e["metrics_ci95"][k] or [m, m]))
+        if "lf_heading_rms_deg" not in out and "heading_rms_deg" in out:  # calm: the same
+            out["lf_heading_rms_deg"] = out["heading_rms_deg"]
+        return out
+
+    rows = []
+    for (env, name, cond), e in by_key.items():
+        if (env, cond) != (env_id, "seaway"):
+            continue
+        calm_name = "classic" if name == "classic-wf" else name
+        rows.append({
+            "controller": name,
+            "calm": stats(by_key.get((env_id, calm_name, "nominal"))),
+            "seaway": stats(e),
+            "blown_up": _blew_up(e),
+        })  # fmt: skip
+    return rows
+
+
+def seaway_table(entries: Sequence[dict[str, Any]]) -> list[str]:
+    """Markdown lines: per env, each controller in the seaway condition against calm water
+    (the nominal condition, same seeds): the return, the error the task is about (the
+    low-frequency heading error of the heading tasks), the measured heading error, the
+    rudder (azimuth) travel and reversals and the propulsion energy; calm values in
+    parentheses, means over episodes."""
+    lines: list[str] = []
+    for env_id in dict.fromkeys(e["env"] for e in entries if e["condition"] == "seaway"):
+        error = seaway_error_key(env_id)
+        rows = seaway_rows(entries, env_id)
+        keys = ["return", error] + [
+            k for k in SEAWAY_KEYS
+            if k != error and rows and rows[0]["seaway"] and k in rows[0]["seaway"]
+        ]  # fmt: skip
+        lines += [
+            f"**{_label(env_id)}**: at sea (calm water)",
+            "",
+            "| controller | " + " | ".join(keys) + " |",
+            "|---|" + "---:|" * len(keys),
+        ]
+        for r in rows:
+            if r["blown_up"]:
+                blew = f"| {r['controller']} | **{r['blown_up']}** |"
+                lines.append(blew + " — |" * (len(keys) - 1))
+                continue
+            cells = []
+            for k in keys:
+                sea = r["seaway"][k][0]
+                calm = r["calm"][k][0] if r["calm"] and k in r["calm"] else None
+                cells.append(_g(sea) + (f" ({_g(calm)})" if calm is not None else ""))
+            lines.append(f"| {r['controller']} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
+
+
 def render_markdown(
     entries: Sequence[dict[str, Any]],
     throughput: Sequence[dict[str, Any]] | None,

@@ -19,9 +19,18 @@ controller). Conditions:
 * ``noise``: :class:`~shipgym.envs.wrappers.VectorSensorNoise` at its default levels (heading 0.5
   deg, yaw rate 0.1 deg/s, speed 0.1 m/s, position 1 m);
 * ``delay``: :class:`~shipgym.envs.wrappers.VectorActuatorDelay` of :data:`ACTUATOR_DELAY_STEPS`
-  control steps (1 s on the Gunnerus, 2 s on the Mariner).
+  control steps (1 s on the Gunnerus, 2 s on the Mariner);
+* ``seaway``: the ship at sea (:data:`SEAWAY`): a moderate sea, WMO sea state 4 (``H_s``
+  2.0 m, JONSWAP with gamma 3.3, the peak period of each ship's waters) and a fresh breeze,
+  Beaufort 5 (9.5 m/s at 10 m, with NORSOK gusts), the wind's and the waves' directions drawn
+  uniformly per episode (from its seed: the same sea for every controller), on top of the
+  env's own current. The controllers sail on the measured heading, which carries the
+  wave-frequency motion; the heading tasks' ``lf_heading_rms_deg`` is the error of the
+  low-frequency heading the autopilot is to hold.
 
-The ``zero`` command, a baseline, runs in the nominal condition only. The default first seed,
+The ``zero`` command, a baseline, runs in the nominal condition only; ``classic-wf`` (the
+``classic`` controller with a wave filter in its heading loop, which in calm water passes the
+heading through unchanged) in the seaway condition only. The default first seed,
 :data:`shipgym.rl.train.BENCHMARK_SEED`, lies outside every agent's training and validation
 seeds and the tuning seeds; :func:`run_benchmark` checks that against each agent's record.
 
@@ -65,10 +74,39 @@ from shipgym.envs.wrappers import VectorActuatorDelay, VectorSensorNoise
 from shipgym.rl.agents import agent_files, load_meta
 from shipgym.rl.train import ALGOS, BENCHMARK_SEED
 
-CONTROLLERS = ("classic", "classic-tuned", "ppo", "sac", "zero")
-CONDITIONS = ("nominal", "stress", "mismatch", "noise", "delay")
+CONTROLLERS = ("classic", "classic-wf", "classic-tuned", "ppo", "sac", "zero")
+CONDITIONS = ("nominal", "stress", "mismatch", "noise", "delay", "seaway")
 #: Controllers run in the nominal condition only (baselines).
 NOMINAL_ONLY = ("zero",)
+#: Controllers run in the seaway condition only (in calm water the same as another).
+SEAWAY_ONLY = ("classic-wf",)
+#: Seaway condition: significant wave height [m] (WMO sea state 4, "moderate", 1.25-2.5 m).
+SEAWAY_HEIGHT = 2.0
+#: Seaway condition: mean wind speed at 10 m [m/s] (Beaufort 5, "fresh breeze", 8.0-10.7 m/s).
+SEAWAY_WIND_SPEED = 9.5
+#: Seaway condition: peak period [s] of each task's waters. The Mariner, an ocean-going cargo
+#: ship: 8.8 s, the most probable modal period of sea state 4 in the open North Atlantic
+#: (Lee and Bales 1984, as tabulated in NATO STANAG 4194). The R/V Gunnerus, a coastal
+#: research vessel off mid-Norway: 7.0 s, the fully developed wind sea of the fresh breeze
+#: itself (Pierson-Moskowitz, ``omega_p = 0.877 g / U`` and ``H_s = 0.21 U^2 / g``: 6.9 to
+#: 7.1 s and 1.9 to 2.0 m for ``U`` 9.5 m/s at 10 m to 9.75 m/s at 19.5 m), shorter than the
+#: ocean's mixed sea with swell.
+SEAWAY_PERIOD: dict[str, float] = {
+    "NomotoHeading": 8.8,
+    "RVGHeading": 7.0,
+    "RVGSpeed": 7.0,
+    "RVGPathFollowing": 7.0,
+    "RVGTargetTracking": 7.0,
+}
+#: The seaway condition of each task (:func:`env_task`): the ``wind`` and ``sea_state``
+#: options of every episode's reset (directions left out: drawn uniformly per episode).
+SEAWAY: dict[str, dict[str, dict[str, float]]] = {
+    task: {
+        "wind": {"speed": SEAWAY_WIND_SPEED},
+        "sea_state": {"significant_height": SEAWAY_HEIGHT, "peak_period": period},
+    }
+    for task, period in SEAWAY_PERIOD.items()
+}
 #: Stress condition: current speed as a multiple of the training maximum.
 STRESS_FACTOR = 1.5
 #: Actuator-delay condition: the delay in control steps of the env.
@@ -133,6 +171,8 @@ def scenarios(env_id: str, condition: str, stress_current: float) -> list[Scenar
         return [Scenario("noise", wrappers=(VectorSensorNoise,))]
     if condition == "delay":
         return [Scenario("delay", wrappers=(delayed,))]
+    if condition == "seaway":
+        return [Scenario("seaway", reset_options=SEAWAY[env_task(env_id)])]
     raise ValueError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
 
 
@@ -141,14 +181,16 @@ def benchmark_cells(
 ) -> list[tuple[str, str, str]]:
     """The cells of a benchmark, in table order: ``(env, condition, scenario label)`` of each
     scenario and each controller (the baselines of :data:`NOMINAL_ONLY` in the nominal
-    condition only), as ``(env, condition, label, controller)``."""
+    condition only, those of :data:`SEAWAY_ONLY` in the seaway only), as ``(env, condition,
+    label, controller)``."""
     return [
         (env_id, condition, scenario.label, name)
         for env_id in envs
         for condition in conditions
         for scenario in scenarios(env_id, condition, 0.0)
         for name in controllers
-        if scenario.label == "nominal" or name not in NOMINAL_ONLY
+        if (scenario.label == "nominal" or name not in NOMINAL_ONLY)
+        and (condition == "seaway" or name not in SEAWAY_ONLY)
     ]
 
 
