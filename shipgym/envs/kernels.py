@@ -386,6 +386,21 @@ def path_geometry(px, py, xk, yk, cs, sn, length):
     return -dn * sn + de * cs, length - (dn * cs + de * sn)
 
 
+@row_kernel
+def on_leg(x, i, k, tangent, leg_length):
+    """:func:`path_geometry` of row ``i`` of the states ``x`` on its leg ``k`` (the path
+    tables of :func:`set_path_legs`)."""
+    return path_geometry(
+        x[i, 0],
+        x[i, 1],
+        tangent[i, k, 0],
+        tangent[i, k, 1],
+        tangent[i, k, 2],
+        tangent[i, k, 3],
+        leg_length[i, k],
+    )
+
+
 def _path(
     advance,
     rows,
@@ -442,15 +457,7 @@ def _path(
         for b in range(m):  # along-track distance left before the step
             i = rows[start + b]
             k = seg[i]
-            s_before[b] = path_geometry(
-                x[i, 0],
-                x[i, 1],
-                tangent[i, k, 0],
-                tangent[i, k, 1],
-                tangent[i, k, 2],
-                tangent[i, k, 3],
-                leg_length[i, k],
-            )[1]
+            s_before[b] = on_leg(x, i, k, tangent, leg_length)[1]
         if advance:
             _advance_block(
                 full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
@@ -462,15 +469,7 @@ def _path(
                 continue
             i = rows[start + b]
             k = seg[i]
-            e, s_left = path_geometry(
-                x[i, 0],
-                x[i, 1],
-                tangent[i, k, 0],
-                tangent[i, k, 1],
-                tangent[i, k, 2],
-                tangent[i, k, 3],
-                leg_length[i, k],
-            )
+            e, s_left = on_leg(x, i, k, tangent, leg_length)
             progress = s_before[b] - s_left
             # within the acceptance radius of the leg's end, compared squared (no hypot call)
             dn_end = x[i, 0] - tangent[i, k + 1, 0]
@@ -480,15 +479,7 @@ def _path(
                 if k + 2 < n_wp[i]:
                     k += 1
                     seg[i] = k
-                    e, s_left = path_geometry(
-                        x[i, 0],
-                        x[i, 1],
-                        tangent[i, k, 0],
-                        tangent[i, k, 1],
-                        tangent[i, k, 2],
-                        tangent[i, k, 3],
-                        leg_length[i, k],
-                    )
+                    e, s_left = on_leg(x, i, k, tangent, leg_length)
                 else:
                     term[i] = True
                     reason[i] = SUCCESS
@@ -500,15 +491,7 @@ def _path(
             chi_err = ssa_scalar(leg_angle[i, k] - x[i, 2])
             e_m, s_m, chi_m = e, s_left, chi_err  # as measured
             if sw[0]:
-                e_m, s_m = path_geometry(
-                    xm[i, 0],
-                    xm[i, 1],
-                    tangent[i, k, 0],
-                    tangent[i, k, 1],
-                    tangent[i, k, 2],
-                    tangent[i, k, 3],
-                    leg_length[i, k],
-                )
+                e_m, s_m = on_leg(xm, i, k, tangent, leg_length)
                 chi_m = ssa_scalar(leg_angle[i, k] - xm[i, 2])
             new[b, 0] = e_m
             new[b, 1] = chi_m
