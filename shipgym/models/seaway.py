@@ -260,18 +260,12 @@ def wave_damping(gamma: float) -> float:
  S_WAVE_DIR) = range(16)  # fmt: skip
 N_SEA = 16
 #: Columns of a ship's seaway states: gust, the AR(2) process now and before, the wave motion
-#: (north, east, heading, yaw rate), the wind speed of the moment, and the AR(2) coefficients
-#: with the encounter frequency they were made for.
-#: Then the encounter angle they and the wave-motion gains and drift were looked up at, the
-#: gains and the drift load.
-(W_GUST, W_Y, W_Y_PREV, W_NORTH, W_EAST, W_PSI, W_R, W_SPEED, W_WE, W_RHO, W_COS, W_SIN,
- W_S, W_BETA, W_GXI, W_GPSI, W_DX, W_DY, W_DN) = range(19)  # fmt: skip
-N_WF = 19
-#: Relative change of the encounter frequency that remakes a ship's AR(2) coefficients.
-RETUNE = 0.005
-#: Change of the encounter angle [rad] (0.25 deg) that looks its wave-motion gains and drift
-#: up again (tables every 10 and 2 deg: a step costs a fifth less than looking up each time).
-RETUNE_ANGLE = math.radians(0.25)
+#: (north, east, heading, yaw rate), the wind speed of the moment and (beside it, for the
+#: ``info`` of the envs) the direction the wind comes from.
+W_GUST, W_Y, W_Y_PREV, W_NORTH, W_EAST, W_PSI, W_R, W_SPEED, W_FROM = range(9)
+N_WF = 9
+#: Largest ``lambda omega_e dt`` of the AR(2) process (its pole radius at least exp(-1.5)).
+_MAX_DECAY = 1.5
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -279,6 +273,8 @@ _MIX2 = np.uint64(0x94D049BB133111EB)
 _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
 _SQRT12 = math.sqrt(12.0)
 _TWO_PI = 2.0 * math.pi
+#: ``(v + _ROUND) - _ROUND`` rounds ``|v| < 2^51`` to the nearest integer (no library call)
+_ROUND = 6755399441055744.0
 
 
 @row_kernel
@@ -301,147 +297,167 @@ def normal(rng, i):
 
 
 @row_kernel
+def _exp_neg(z):
+    """``exp(-z)`` for ``0 <= z <= 1.5`` to 1e-12 relative, straight-line (the Taylor series of
+    ``exp(-z / 4)`` to the 10th power, squared twice)."""
+    q = -0.25 * z
+    e = 1.0 + q * (1.0 + q / 2.0 * (1.0 + q / 3.0 * (1.0 + q / 4.0 * (1.0 + q / 5.0 * (
+        1.0 + q / 6.0 * (1.0 + q / 7.0 * (1.0 + q / 8.0 * (1.0 + q / 9.0 * (
+            1.0 + q / 10.0)))))))))  # fmt: skip
+    e *= e
+    return e * e
+
+
+@row_kernel
+def ar2_coefficients(lam, we, dt):
+    """``(rho, cos theta, sin theta, s)`` of the unit-variance AR(2) wave process (module
+    docstring) of damping ``lam`` at the encounter frequency ``we`` [rad/s], step ``dt`` [s]."""
+    rho = _exp_neg(min(lam * we * dt, _MAX_DECAY))
+    st, ct = sincos(min(we * math.sqrt(1.0 - lam * lam) * dt, 3.0))
+    r2 = rho * rho
+    p2 = 1.0 + r2
+    return rho, ct, st, math.sqrt((1.0 - r2) * (p2 * p2 - 4.0 * r2 * ct * ct) / p2)
+
+
+@row_kernel
+def encounter_peak(wp, speed, cos_beta):
+    """``|omega_p - omega_p^2 U cos(beta) / g|``, at least MIN_ENCOUNTER_FREQUENCY [rad/s]."""
+    return max(abs(wp - wp * wp * speed * cos_beta / GRAVITY), MIN_ENCOUNTER_FREQUENCY)
+
+
+@row_kernel
 def _cell(angle, cells):
-    """Cell ``k`` and fraction ``f`` of ``angle`` (wrapped to ``[-pi, pi)``) on a grid of
+    """Cell (as a float) and fraction of ``angle`` [rad] (any number of turns) on a grid of
     ``cells`` equal cells over ``[-pi, pi]``."""
-    t = (angle + math.pi) * (cells / _TWO_PI)
-    t -= cells * math.floor(t / cells)  # wrapped
-    k = min(int(t), cells - 1)
+    t = (angle + math.pi) * (1.0 / _TWO_PI)
+    # floors by rounding t - 1/2 (a select-free form that vectorises; math.floor does not): an
+    # integer t may floor to t - 1, with the fraction 1 instead of 0, the same point
+    t = (t - ((t - 0.5 + _ROUND) - _ROUND)) * cells  # the fraction of a turn, in cells
+    k = min(max((t - 0.5 + _ROUND) - _ROUND, 0.0), cells - 1.0)
     return k, t - k
 
 
 @row_kernel
-def _ar2(sea, wf, i, we, dt):
-    """Remake ship ``i``'s AR(2) coefficients for the encounter frequency ``we``."""
-    lam = sea[i, S_LAMBDA]
-    rho = math.exp(-lam * we * dt)
-    theta = min(we * math.sqrt(1.0 - lam * lam) * dt, 3.0)
-    st, ct = sincos(theta)
-    r2 = rho * rho
-    wf[i, W_WE] = we
-    wf[i, W_RHO] = rho
-    wf[i, W_COS] = ct
-    wf[i, W_SIN] = st
-    wf[i, W_S] = math.sqrt((1.0 - r2) * ((1.0 + r2) ** 2 - 4.0 * r2 * ct * ct) / (1.0 + r2))
+def _lerp(table, row, k, f):
+    """``table[row]`` between cells ``k`` (a float from :func:`_cell`) and ``k + 1``."""
+    j = int(k)
+    return table[row, j] + f * (table[row, j + 1] - table[row, j])
+
+
+# The seaway of a block of ships in three passes. A loop over ships vectorises (SIMD code) only
+# if it reads and writes the columns of a small table by the ship's place in the block: it must
+# not gather (a row chosen by ``rows``, a table cell chosen by an angle). So: gather each
+# ship's numbers into the columns of ``work``; compute the sines, cosines, arctangents and the
+# AR(2) coefficients of every ship in one loop of straight-line arithmetic (the long chains of
+# dependent operations that one ship at a time waits on); then look the tables up and scatter.
+(_PSI, _U, _V, _CN, _CE, _WCOS, _WSIN, _WDIR, _WP, _LAM, _WIND, _WINDC, _WINDS, _GA, _GB, _G,
+ _Y, _YP, _N1, _N2, _WE, _QUAD, _KG, _FG, _KB, _FB, _KW, _FW, _Q, _SPEED) = range(30)  # fmt: skip
+_WORK_ROWS = 30
 
 
 @row_kernel
-def _look_up(sea, wf, tables, gains, i, beta):
-    """Look ship ``i``'s wave-motion gains (times ``sigma_zeta``) and drift load up at the
-    encounter angle ``beta``."""
-    wf[i, W_BETA] = beta
-    k, f = _cell(beta, gains.shape[2] - 1)
-    sz = sea[i, S_SIGMA_ZETA]
-    wf[i, W_GXI] = sz * (gains[i, 0, k] + f * (gains[i, 0, k + 1] - gains[i, 0, k]))
-    wf[i, W_GPSI] = sz * (gains[i, 1, k] + f * (gains[i, 1, k + 1] - gains[i, 1, k]))
-    k, f = _cell(beta, tables.shape[1] - 1)
-    drift = sea[i, S_DRIFT]
-    wf[i, W_DX] = drift * (tables[3, k] + f * (tables[3, k + 1] - tables[3, k]))
-    wf[i, W_DY] = drift * (tables[4, k] + f * (tables[4, k + 1] - tables[4, k]))
-    wf[i, W_DN] = drift * (tables[5, k] + f * (tables[5, k + 1] - tables[5, k]))
-
-
-@row_kernel
-def _encounter(sea, x, c, i, sn, cs):
-    """Ship ``i``'s encounter peak frequency now (at least MIN_ENCOUNTER_FREQUENCY)."""
-    cb = sea[i, S_WAVE_COS] * cs + sea[i, S_WAVE_SIN] * sn  # cos(beta_w - psi)
-    ur = x[i, 3]
-    if x.shape[1] > 7:  # a 3-DOF ship's surge is over ground: its speed through the water
-        ur -= c[i, 0] * cs + c[i, 1] * sn
-    wp = sea[i, S_OMEGA_P]
-    return max(abs(wp - wp * wp * ur * cb / GRAVITY), MIN_ENCOUNTER_FREQUENCY)
-
-
-@row_kernel
-def _block_angles(rows, start, n, x, c, sea, wf, rng, ship, advance, work):
-    """The first passes of :func:`seaway_block`: each ship's heading's sine and cosine, its
-    gust, and the apparent wind's dynamic pressure and angle, into ``work``. Loops of
-    straight-line code over the ships (SIMD code: the sine, cosine and arctangent are long
-    chains of dependent operations that one ship at a time would wait for)."""
-    for b in range(n):
-        sn, cs = sincos(x[rows[start + b], 2])
-        work[0, b] = sn
-        work[1, b] = cs
-    for b in range(n):  # the gusts (a stream per ship)
-        i = rows[start + b]
-        g = wf[i, W_GUST]
-        if advance and sea[i, S_WIND] > 0.0:
-            g = sea[i, S_GUST_A] * g + sea[i, S_GUST_B] * noise(rng, i)
-        work[2, b] = g
-    nomoto = ship[0] == NOMOTO_KIND
+def _gather(rows, start, n, x, c, sea, wf, rng, advance, work):
+    """Copy the block's ships' numbers into the columns of ``work`` and draw their noise."""
     for b in range(n):
         i = rows[start + b]
-        sn = work[0, b]
-        cs = work[1, b]
-        mean = sea[i, S_WIND]
-        speed = max(mean + work[2, b], 0.0) if mean > 0.0 else 0.0
-        uc = c[i, 0] * cs + c[i, 1] * sn
-        vc = -c[i, 0] * sn + c[i, 1] * cs
-        # over ground: a Nomoto ship along its heading plus the current
-        ug = x[i, 3] + uc if nomoto else x[i, 3]
-        vg = vc if nomoto else x[i, 4]
-        # the apparent wind (shipgym.models.wind.apparent_wind)
-        cw = sea[i, S_WIND_COS]
-        sw = sea[i, S_WIND_SIN]
+        work[_PSI, b] = x[i, 2]
+        work[_U, b] = x[i, 3]
+        work[_V, b] = x[i, 4]
+        work[_CN, b] = c[i, 0]
+        work[_CE, b] = c[i, 1]
+        work[_WCOS, b] = sea[i, S_WAVE_COS]
+        work[_WSIN, b] = sea[i, S_WAVE_SIN]
+        work[_WDIR, b] = sea[i, S_WAVE_DIR]
+        work[_WP, b] = sea[i, S_OMEGA_P]
+        work[_LAM, b] = sea[i, S_LAMBDA]
+        work[_WIND, b] = sea[i, S_WIND]
+        work[_WINDC, b] = sea[i, S_WIND_COS]
+        work[_WINDS, b] = sea[i, S_WIND_SIN]
+        work[_GA, b] = sea[i, S_GUST_A]
+        work[_GB, b] = sea[i, S_GUST_B]
+        work[_G, b] = wf[i, W_GUST]
+        work[_Y, b] = wf[i, W_Y]
+        work[_YP, b] = wf[i, W_Y_PREV]
+        work[_N1, b] = noise(rng, i) if advance else 0.0
+        work[_N2, b] = noise(rng, i) if advance else 0.0
+
+
+@row_kernel
+def _motion(n, nomoto, dt, advance, cells, gain_cells, work):
+    """Every ship's wave process, gust, apparent wind and the table cells of its encounter and
+    apparent wind angles (``cells`` and ``gain_cells`` of the load and gain tables):
+    straight-line code on ``work``."""
+    keep = 1.0 if advance else 0.0
+    three_dof = 0.0 if nomoto else 1.0
+    for b in range(n):
+        sn, cs = sincos(work[_PSI, b])
+        cn = work[_CN, b]
+        ce = work[_CE, b]
+        uc = cn * cs + ce * sn
+        vc = -cn * sn + ce * cs
+        # the AR(2) wave process at the encounter frequency of the moment
+        ur = work[_U, b] - three_dof * uc  # a 3-DOF ship's surge is over ground
+        cos_beta = work[_WCOS, b] * cs + work[_WSIN, b] * sn
+        we = encounter_peak(work[_WP, b], ur, cos_beta)
+        rho, ct, st, s = ar2_coefficients(work[_LAM, b], we, dt)
+        y0 = work[_Y, b]
+        yp0 = work[_YP, b]
+        y = keep * (2.0 * rho * ct * y0 - rho * rho * yp0 + s * work[_N1, b]) + (1.0 - keep) * y0
+        yp = keep * y0 + (1.0 - keep) * yp0
+        # the gust and the apparent wind (shipgym.models.wind.apparent_wind); none in calm air
+        mean = work[_WIND, b]
+        on = 1.0 if mean > 0.0 else 0.0
+        g0 = work[_G, b]
+        g = keep * (work[_GA, b] * g0 + work[_GB, b] * work[_N2, b]) + (1.0 - keep) * g0
+        speed = on * max(mean + g, 0.0)
+        ug = work[_U, b] + (1.0 - three_dof) * uc  # over ground: a Nomoto ship along its heading
+        vg = three_dof * work[_V, b] + (1.0 - three_dof) * vc
+        cw = work[_WINDC, b]
+        sw = work[_WINDS, b]
         ax = -speed * (cw * cs + sw * sn) - ug
         ay = -speed * (-cw * sn + sw * cs) - vg
-        work[3, b] = speed
-        work[4, b] = 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay) if mean > 0.0 else 0.0
-        work[5, b] = atan2(-ay, -ax)
+        work[_Y, b] = y
+        work[_YP, b] = yp
+        work[_G, b] = g
+        work[_SPEED, b] = speed
+        work[_WE, b] = we
+        work[_QUAD, b] = (rho * yp - y * ct) / st
+        beta = work[_WDIR, b] - work[_PSI, b]
+        work[_KG, b], work[_FG, b] = _cell(beta, gain_cells)
+        work[_KB, b], work[_FB, b] = _cell(beta, cells)
+        work[_KW, b], work[_FW, b] = _cell(atan2(-ay, -ax), cells)
+        work[_Q, b] = on * 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay)
 
 
 @row_kernel
-def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir, dt, advance):
-    """The seaway of ships ``rows[start:start + n]`` after a step (``advance``) or at a reset
-    (module docstring).
-
-    Advances their wave processes and gusts on a step; sets their measured states ``xm``
-    (``x`` plus the wave-frequency motion: north, east, heading and, at ``ir``, yaw rate) and
-    their loads of the coming step, ``c[:, 2:5]``, from the states now. ``sea``, ``wf`` and
-    ``rng`` are the ships' parameters, states and noise streams, ``tables`` the ship's wind
-    and drift coefficients (6 rows), ``gains`` the ships' wave-motion gains, ``ship`` its
-    :meth:`SeawayShip.constants`. A ship's result does not depend on the others'.
-    """
-    work = np.empty((6, n))
-    _block_angles(rows, start, n, x, c, sea, wf, rng, ship, advance, work)
-    nomoto = ship[0] == NOMOTO_KIND
-    cells = tables.shape[1] - 1
+def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
+    """Look the block's ships' wave-motion gains, drift and wind coefficients up, and write
+    their states, loads and measured states."""
     for b in range(n):
         i = rows[start + b]
-        sn = work[0, b]
-        cs = work[1, b]
-        beta = sea[i, S_WAVE_DIR] - x[i, 2]
-        we = _encounter(sea, x, c, i, sn, cs)
-        if abs(we - wf[i, W_WE]) > RETUNE * we:
-            _ar2(sea, wf, i, we, dt)
-        if abs(beta - wf[i, W_BETA]) > RETUNE_ANGLE:
-            _look_up(sea, wf, tables, gains, i, beta)
-        rho = wf[i, W_RHO]
-        ct = wf[i, W_COS]
-        y = wf[i, W_Y]
-        yp = wf[i, W_Y_PREV]
-        if advance:
-            y, yp = 2.0 * rho * ct * y - rho * rho * yp + wf[i, W_S] * noise(rng, i), y
-        quad = (rho * yp - y * ct) / wf[i, W_SIN]
-        north = wf[i, W_GXI] * y * sea[i, S_WAVE_COS]
-        east = wf[i, W_GXI] * y * sea[i, S_WAVE_SIN]
-        psi_w = wf[i, W_GPSI] * quad
-        r_w = wf[i, W_GPSI] * wf[i, W_WE] * y
-        # the load of the coming step: wind (none in calm air) and mean wave drift
-        q = work[4, b]
-        k, f = _cell(work[5, b], cells)
-        fx = wf[i, W_DX] + q * (tables[0, k] + f * (tables[0, k + 1] - tables[0, k]))
-        fy = wf[i, W_DY] + q * (tables[1, k] + f * (tables[1, k + 1] - tables[1, k]))
-        fn = wf[i, W_DN] + q * (tables[2, k] + f * (tables[2, k + 1] - tables[2, k]))
-        if nomoto:
+        y = work[_Y, b]
+        sz = sea[i, S_SIGMA_ZETA]
+        kg, fg, kb, fb, kw, fw = (work[_KG, b], work[_FG, b], work[_KB, b], work[_FB, b],
+                                  work[_KW, b], work[_FW, b])  # fmt: skip
+        xi = sz * _lerp(gains[i], 0, kg, fg) * y
+        gy = sz * _lerp(gains[i], 1, kg, fg)
+        north = xi * sea[i, S_WAVE_COS]
+        east = xi * sea[i, S_WAVE_SIN]
+        psi_w = gy * work[_QUAD, b]
+        r_w = gy * work[_WE, b] * y
+        drift = sea[i, S_DRIFT]
+        q = work[_Q, b]
+        fx = drift * _lerp(tables, 3, kb, fb) + q * _lerp(tables, 0, kw, fw)
+        fy = drift * _lerp(tables, 4, kb, fb) + q * _lerp(tables, 1, kw, fw)
+        fn = drift * _lerp(tables, 5, kb, fb) + q * _lerp(tables, 2, kw, fw)
+        if ship[0] == NOMOTO_KIND:  # the equivalent rudder angle and the leeway
             u = max(x[i, 3], MIN_NOMOTO_SPEED)
-            length = ship[3]
-            qw = 0.5 * WATER_DENSITY * u * length * length
-            fx, fy, fn = fn / (ship[1] * qw * u * length), fy / (-ship[2] * qw), 0.0
+            qw = 0.5 * WATER_DENSITY * u * ship[3] * ship[3]
+            fx, fy, fn = fn / (ship[1] * qw * u * ship[3]), fy / (-ship[2] * qw), 0.0
         wf[i, W_Y] = y
-        wf[i, W_Y_PREV] = yp
-        wf[i, W_GUST] = work[2, b]
-        wf[i, W_SPEED] = work[3, b]
+        wf[i, W_Y_PREV] = work[_YP, b]
+        wf[i, W_GUST] = work[_G, b]
+        wf[i, W_SPEED] = work[_SPEED, b]
         wf[i, W_NORTH] = north
         wf[i, W_EAST] = east
         wf[i, W_PSI] = psi_w
@@ -457,17 +473,39 @@ def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir
         xm[i, ir] += r_w
 
 
+@row_kernel
+def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir, dt, advance):
+    """The seaway of ships ``rows[start:start + n]`` after a step (``advance``) or at a reset
+    (module docstring).
+
+    Advances their wave processes and gusts on a step; sets their measured states ``xm``
+    (``x`` plus the wave-frequency motion: north, east, heading and, at ``ir``, yaw rate) and
+    their loads of the coming step, ``c[:, 2:5]``, from the states now. ``sea``, ``wf`` and
+    ``rng`` are the ships' parameters, states and noise streams, ``tables`` the ship's wind
+    and drift coefficients (6 rows), ``gains`` the ships' wave-motion gains, ``ship`` its
+    :meth:`SeawayShip.constants`. A ship's result does not depend on the others'.
+    """
+    work = np.empty((_WORK_ROWS, n))
+    _gather(rows, start, n, x, c, sea, wf, rng, advance, work)
+    cells, gain_cells = tables.shape[1] - 1.0, gains.shape[2] - 1.0
+    _motion(n, ship[0] == NOMOTO_KIND, dt, advance, cells, gain_cells, work)
+    _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work)
+
+
 @kernel
 def start_rows(rows, x, c, sea, wf, rng, dt):
     """Start the gusts and the AR(2) wave process of each ship of ``rows`` (at a reset) in
     their stationary distribution."""
     for i in rows:
-        wf[i, W_BETA] = math.inf  # looked up at the first step
         wf[i, W_GUST] = sea[i, S_GUST_SIGMA] * normal(rng, i)
         sn, cs = sincos(x[i, 2])
-        _ar2(sea, wf, i, _encounter(sea, x, c, i, sn, cs), dt)
-        rho = wf[i, W_RHO]
-        lag1 = 2.0 * rho * wf[i, W_COS] / (1.0 + rho * rho)  # the lag-one correlation
+        ur = x[i, 3]
+        if x.shape[1] > 7:  # a 3-DOF ship's surge is over ground
+            ur -= c[i, 0] * cs + c[i, 1] * sn
+        cos_beta = sea[i, S_WAVE_COS] * cs + sea[i, S_WAVE_SIN] * sn
+        we = encounter_peak(sea[i, S_OMEGA_P], ur, cos_beta)
+        rho, ct, _, _ = ar2_coefficients(sea[i, S_LAMBDA], we, dt)
+        lag1 = 2.0 * rho * ct / (1.0 + rho * rho)  # the lag-one correlation
         y = normal(rng, i)
         wf[i, W_Y] = y
         wf[i, W_Y_PREV] = lag1 * y + math.sqrt(max(1.0 - lag1 * lag1, 0.0)) * normal(rng, i)

@@ -250,6 +250,7 @@ class SeawayArrays:
             s[rows, sw.S_WIND] = speed
             direction = _drawn(wind.direction, draws[:, 1], -math.pi, math.pi)
             s[rows, sw.S_WIND_FROM] = direction
+            self.wf[rows, sw.W_FROM] = direction
             s[rows, sw.S_WIND_COS] = np.cos(direction)
             s[rows, sw.S_WIND_SIN] = np.sin(direction)
             s[rows, sw.S_GUST_A] = 1.0
@@ -287,10 +288,10 @@ class SeawayArrays:
         ``sea_state`` (``H_s`` [m], ``T_p`` [s], direction the waves travel to [rad]; zeros in
         calm water) and ``wave_motion`` (the wave-frequency motion added to the measured
         state: north, east [m], heading [rad])."""
-        s, w = self.sea, self.wf
+        s, w = self.sea, self.wf  # (each entry's columns side by side: one copy each)
         return {
-            "wind": np.column_stack((w[rows, sw.W_SPEED], s[rows, sw.S_WIND_FROM])),
-            "sea_state": np.array(s[rows][:, [sw.S_HS, sw.S_TP, sw.S_WAVE_DIR]]),
+            "wind": np.array(w[rows, sw.W_SPEED : sw.W_FROM + 1]),
+            "sea_state": np.array(s[rows, sw.S_HS : sw.S_WAVE_DIR + 1]),
             "wave_motion": np.array(w[rows, sw.W_NORTH : sw.W_PSI + 1]),
         }
 
@@ -298,7 +299,7 @@ class SeawayArrays:
         """:meth:`info` of row ``i`` (the single env's)."""
         s, w = self.sea, self.wf
         return {
-            "wind": np.array((w[i, sw.W_SPEED], s[i, sw.S_WIND_FROM])),
-            "sea_state": s[i, [sw.S_HS, sw.S_TP, sw.S_WAVE_DIR]],
+            "wind": w[i, sw.W_SPEED : sw.W_FROM + 1].copy(),
+            "sea_state": s[i, sw.S_HS : sw.S_WAVE_DIR + 1].copy(),
             "wave_motion": w[i, sw.W_NORTH : sw.W_PSI + 1].copy(),
         }
