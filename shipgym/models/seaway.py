@@ -255,15 +255,15 @@ def wave_damping(gamma: float) -> float:
 # ``gains[i]`` its wave-motion gains (2, 37), ``ship`` its constants.
 
 #: Columns of a ship's seaway parameters (set at a reset).
-(S_WIND, S_WIND_FROM, S_WIND_COS, S_WIND_SIN, S_GUST_SIGMA, S_GUST_A, S_GUST_B, S_WAVE_COS,
- S_WAVE_SIN, S_OMEGA_P, S_LAMBDA, S_SIGMA_ZETA, S_DRIFT, S_HS, S_TP,
- S_WAVE_DIR) = range(16)  # fmt: skip
-N_SEA = 16
+(S_WIND, S_WIND_COS, S_WIND_SIN, S_GUST_SIGMA, S_GUST_A, S_GUST_B, S_WAVE_COS, S_WAVE_SIN,
+ S_OMEGA_P, S_LAMBDA, S_SIGMA_ZETA, S_DRIFT, S_WAVE_DIR) = range(13)  # fmt: skip
+N_SEA = 13
 #: Columns of a ship's seaway states: gust, the AR(2) process now and before, the wave motion
-#: (north, east, heading, yaw rate), the wind speed of the moment and (beside it, for the
-#: ``info`` of the envs) the direction the wind comes from.
-W_GUST, W_Y, W_Y_PREV, W_NORTH, W_EAST, W_PSI, W_R, W_SPEED, W_FROM = range(9)
-N_WF = 9
+#: (north, east, heading, yaw rate), the wind speed of the moment and, beside it for the
+#: ``info`` of the envs (one copy), the direction the wind comes from and the sea state
+#: (``H_s``, ``T_p``, direction).
+W_GUST, W_Y, W_Y_PREV, W_NORTH, W_EAST, W_PSI, W_R, W_SPEED, W_FROM, W_HS, W_TP, W_WDIR = range(12)
+N_WF = 12
 #: Largest ``lambda omega_e dt`` of the AR(2) process (its pole radius at least exp(-1.5)).
 _MAX_DECAY = 1.5
 

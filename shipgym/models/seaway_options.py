@@ -249,7 +249,6 @@ class SeawayArrays:
             speed = _drawn(wind.speed, draws[:, 0], 0.0, 0.0)
             s[rows, sw.S_WIND] = speed
             direction = _drawn(wind.direction, draws[:, 1], -math.pi, math.pi)
-            s[rows, sw.S_WIND_FROM] = direction
             self.wf[rows, sw.W_FROM] = direction
             s[rows, sw.S_WIND_COS] = np.cos(direction)
             s[rows, sw.S_WIND_SIN] = np.sin(direction)
@@ -264,7 +263,7 @@ class SeawayArrays:
             periods = _drawn(sea.peak_period, draws[:, 3], 0.0, 0.0)
             directions = _drawn(sea.direction, draws[:, 4], -math.pi, math.pi)
             for k, i in enumerate(rows):
-                s[i, sw.S_WAVE_DIR] = directions[k]
+                s[i, sw.S_WAVE_DIR] = self.wf[i, sw.W_WDIR] = directions[k]
                 s[i, sw.S_WAVE_COS] = math.cos(directions[k])
                 s[i, sw.S_WAVE_SIN] = math.sin(directions[k])
                 if heights[k] <= 0.0:
@@ -274,8 +273,8 @@ class SeawayArrays:
                     float(heights[k]), float(periods[k]), sea.gamma, ship.length, ship.draught
                 )
                 self.gains[i] = gains
-                s[i, sw.S_HS] = heights[k]
-                s[i, sw.S_TP] = periods[k]
+                self.wf[i, sw.W_HS] = heights[k]
+                self.wf[i, sw.W_TP] = periods[k]
                 s[i, sw.S_OMEGA_P] = 2.0 * math.pi / periods[k]
                 s[i, sw.S_LAMBDA] = lam
                 s[i, sw.S_SIGMA_ZETA] = heights[k] / 4.0
@@ -288,18 +287,18 @@ class SeawayArrays:
         ``sea_state`` (``H_s`` [m], ``T_p`` [s], direction the waves travel to [rad]; zeros in
         calm water) and ``wave_motion`` (the wave-frequency motion added to the measured
         state: north, east [m], heading [rad])."""
-        s, w = self.sea, self.wf  # (each entry's columns side by side: one copy each)
+        w = self.wf[rows].copy()  # (one copy; the entries are views of it, new at every call)
         return {
-            "wind": np.array(w[rows, sw.W_SPEED : sw.W_FROM + 1]),
-            "sea_state": np.array(s[rows, sw.S_HS : sw.S_WAVE_DIR + 1]),
-            "wave_motion": np.array(w[rows, sw.W_NORTH : sw.W_PSI + 1]),
+            "wind": w[:, sw.W_SPEED : sw.W_FROM + 1],
+            "sea_state": w[:, sw.W_HS : sw.W_WDIR + 1],
+            "wave_motion": w[:, sw.W_NORTH : sw.W_PSI + 1],
         }
 
     def row_info(self, i: int) -> dict[str, Any]:
         """:meth:`info` of row ``i`` (the single env's)."""
-        s, w = self.sea, self.wf
+        w = self.wf[i].copy()
         return {
-            "wind": w[i, sw.W_SPEED : sw.W_FROM + 1].copy(),
-            "sea_state": s[i, sw.S_HS : sw.S_WAVE_DIR + 1].copy(),
-            "wave_motion": w[i, sw.W_NORTH : sw.W_PSI + 1].copy(),
+            "wind": w[sw.W_SPEED : sw.W_FROM + 1],
+            "sea_state": w[sw.W_HS : sw.W_WDIR + 1],
+            "wave_motion": w[sw.W_NORTH : sw.W_PSI + 1],
         }
