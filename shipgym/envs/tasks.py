@@ -474,7 +474,9 @@ class Task:
         self._reset_task(rows, task_draws, options)
         if at_sea or self.seaway is not None:
             seaway = self._start_seaway()
-            sea_draws = draws[:, self.n_draws :] if at_sea else np.zeros((rows.size, 6))
+            sea_draws = draws[:, self.n_draws :]
+            if not at_sea:  # a calm episode in a batch with a seaway: no draws, no seaway
+                sea_draws = np.zeros((rows.size, seaway_options.N_DRAWS))
             seaway.set_rows(rows, wind, sea, sea_draws)
             sw.start_rows(rows, self.x, self.c, seaway.sea, seaway.wf, seaway.rng, self.dt)
         self._kernel(rows.size)(*self._args(False, rows))
