@@ -133,27 +133,31 @@ def plot(results: dict[str, list[dict[str, float | str]]], path: Path) -> Path:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--num-envs", type=int, default=256, help="sub-envs of each vector env")
-    parser.add_argument("--steps", type=int, default=300, help="steps timed per round")
+    parser.add_argument(
+        "--num-envs", type=int, nargs="+", default=[256, 4096], help="sub-envs of a vector env"
+    )
+    parser.add_argument(
+        "--steps", type=int, default=300, help="steps timed per round (at 256 sub-envs; "
+        "fewer in proportion for larger batches)"
+    )
     parser.add_argument("--repeats", type=int, default=7, help="rounds (the median is kept)")
     parser.add_argument("--busy", type=int, default=0, help="helper processes keeping cores busy")
     parser.add_argument("--write", action="store_true", help="idle and busy into the speed page")
     args = parser.parse_args()
     loads = (0, 2) if args.write else (args.busy,)
-    results = {}
+    results, tables = {}, []
     for busy in loads:
-        label = "idle" if busy == 0 else f"{busy} busy processes"
-        print(f"{label}:", flush=True)
-        with BusyCores(busy):
-            results[label] = measure(args.num_envs, args.steps, args.repeats)
-        print(table(results[label], args.num_envs))
+        for num_envs in args.num_envs:
+            label = ("idle" if busy == 0 else f"{busy} busy processes") + f", {num_envs} sub-envs"
+            print(f"{label}:", flush=True)
+            steps = max(20, args.steps * 256 // num_envs)
+            with BusyCores(busy):
+                results[label] = measure(num_envs, steps, args.repeats)
+            tables.append(f"**{label}**\n\n{table(results[label], num_envs)}")
+            print(tables[-1])
     if args.write:
         figure = plot(results, FIGURE)
-        blocks = [
-            f"**{label}** (`python scripts/bench_seaway.py --write`)\n\n"
-            f"{table(rows, args.num_envs)}"
-            for label, rows in results.items()
-        ]
+        blocks = ["`python scripts/bench_seaway.py --write`", *tables]
         figure_link = f"\n\n![step cost at sea](../{figure.name})"
         update_block(PAGE, "\n\n".join(blocks) + figure_link, "bench_seaway")
         print(f"wrote {PAGE} and {figure}")
