@@ -291,9 +291,12 @@ def plot_seaway(entries: list[dict[str, Any]], path: str | Path) -> Path:
             ax.grid(axis="y", alpha=0.3)
         row[1].set_yscale("log")
         row[0].legend(fontsize=8, title="plain: calm, hatched: at sea", title_fontsize=7)
+    from shipgym.benchmark.runner import SEAWAY_HEIGHT, SEAWAY_WIND_SPEED
+
     fig.suptitle(
-        "seaway condition (H_s 2.0 m, wind 9.5 m/s, directions drawn per episode) against "
-        "calm water; classic-wf: classic with the wave filter (calm: classic's bar)",
+        f"seaway condition (H_s {SEAWAY_HEIGHT:g} m, wind {SEAWAY_WIND_SPEED:g} m/s, directions "
+        "drawn per episode) against calm water; classic-wf: classic with the wave filter "
+        "(calm: classic's bar)",
         fontsize=10,
     )
     path = Path(path)
