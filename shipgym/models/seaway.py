@@ -6,8 +6,10 @@ Every part is the package's one function for it (:mod:`shipgym.models.wind`,
 compiled step of every environment, for a batch of ships at once. A ship's seaway is drawn
 from its episode's seed, so an episode's wind and sea are a function of that seed.
 
-Loads (held over the RK4 step like the current, rows 2-4 of the block's disturbances,
-:data:`shipgym.models.integrate.NC`)
+Loads
+    Held over the RK4 step like the current (rows 2-4 of the block's disturbances,
+    :data:`shipgym.models.integrate.NC`).
+
     * Wind: the mean wind ``U_10`` [m/s] from ``beta_wind`` (the direction it comes FROM,
       clockwise from north, the meteorological convention) plus gusts ``g(t)``; the apparent
       wind from the ship's velocity over ground (:func:`~shipgym.models.wind.apparent_wind`);
@@ -35,9 +37,9 @@ Loads (held over the RK4 step like the current, rows 2-4 of the block's disturba
       ``delta_w = N / (N'_delta 1/2 rho U^2 L^3)``, ``v_w = Y / (-Y'_v 1/2 rho U L^2)``, with
       ``U`` at least :data:`MIN_NOMOTO_SPEED`; its surge force is left out.
 
-Wave-frequency motion (added to the measured heading, yaw rate and position; the physics
-integrates the low-frequency motion alone, Fossen 2021 section 10.2.4)
-    A ship in long-crested waves of frequency ``omega`` and amplitude ``zeta_a`` at encounter
+Wave-frequency motion
+    Added to the measured heading, yaw rate and position; the physics integrates the
+    low-frequency motion alone (Fossen 2021, section 10.2.4). A ship in long-crested waves of frequency ``omega`` and amplitude ``zeta_a`` at encounter
     angle ``beta`` is taken to follow the water surface's horizontal orbital motion averaged
     over its length ``L`` (the Froude-Krylov, long-wave limit: a body small against the
     wave moves with the water; its length filters waves shorter than itself). With ``q = k
