@@ -39,10 +39,11 @@ Loads
 
 Wave-frequency motion
     Added to the measured heading, yaw rate and position; the physics integrates the
-    low-frequency motion alone (Fossen 2021, section 10.2.4). A ship in long-crested waves of frequency ``omega`` and amplitude ``zeta_a`` at encounter
-    angle ``beta`` is taken to follow the water surface's horizontal orbital motion averaged
-    over its length ``L`` (the Froude-Krylov, long-wave limit: a body small against the
-    wave moves with the water; its length filters waves shorter than itself). With ``q = k
+    low-frequency motion alone (Fossen 2021, section 10.2.4). A ship in long-crested waves of
+    frequency ``omega`` and amplitude ``zeta_a`` at encounter angle ``beta`` is taken to
+    follow the water surface's horizontal orbital motion averaged over its length ``L`` (the
+    Froude-Krylov, long-wave limit: a body small against the wave moves with the water; its
+    length filters waves shorter than itself). With ``q = k
     cos(beta)``, ``k = omega^2 / g`` and ``a = L / 2``, the displacement along the wave
     direction and the yaw angle (the least-squares rotation of the sway displacement along
     the hull) per unit amplitude are::
