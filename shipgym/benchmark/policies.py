@@ -287,10 +287,12 @@ class HeadingWaveFilter:
         omega = np.maximum(
             np.abs(encounter_frequency(self.peak, speed, beta)), MIN_ENCOUNTER_FREQUENCY
         )
-        std = np.array([
-            abs(np.interp(b, GAIN_ANGLES, _yaw_gains(h, t, self.length))) * h / 4.0
-            for b, h, t in zip(beta, self.height, self.period, strict=True)
-        ])  # fmt: skip
+        # each ship's yaw gain at its encounter angle, interpolated in its own table row
+        t = (beta - GAIN_ANGLES[0]) / (GAIN_ANGLES[1] - GAIN_ANGLES[0])
+        k = np.clip(np.floor(t).astype(np.int64), 0, GAIN_ANGLES.size - 2)
+        rows = np.arange(len(psi))
+        low, high = self.yaw_gains[rows, k], self.yaw_gains[rows, k + 1]
+        std = np.abs(low + (t - k) * (high - low)) * self.height / 4.0
         return (
             np.round(np.log(omega) / SCHEDULE_FREQUENCY_STEP),
             np.round(np.log(np.maximum(std, MIN_WAVE_HEADING_STD)) / SCHEDULE_STD_STEP),
@@ -323,6 +325,11 @@ class HeadingWaveFilter:
             self.filter = None
             return
         self.peak = 2.0 * math.pi / np.where(self.at_sea, self.period, 2.0 * math.pi)
+        #: each ship's yaw gains over GAIN_ANGLES (a table per sea, made once per sea)
+        self.yaw_gains = np.array([
+            _yaw_gains(h, t, self.length) if h > 0.0 else np.zeros(GAIN_ANGLES.size)
+            for h, t in zip(self.height, self.period, strict=True)
+        ])  # fmt: skip
         self.filter = WaveFilter(
             self.K, self.T, self.dt, np.ones(n), np.full(n, MIN_WAVE_HEADING_STD)
         )

@@ -140,6 +140,12 @@ _STATE_UNITS = {
 }
 
 
+#: The kernels' seaway argument in calm water (the types of ``SeawayArrays.kernel_args``, no
+#: ships; never written).
+_CALM_SEAWAY = (False, np.zeros((0, 0)), np.zeros((0, 0)), np.zeros(0, dtype=np.uint64),
+                np.zeros((0, 0)), np.zeros((0, 0, 0)), np.zeros(0), 0)  # fmt: skip
+
+
 def _uniform(u: np.ndarray, low: float, high: float) -> np.ndarray:
     return low + (high - low) * u
 
@@ -328,12 +334,8 @@ class Task:
     seaway_ship: ClassVar[Callable[[], sw.SeawayShip] | None] = None
 
     def _seaway_args(self) -> tuple[Any, ...]:
-        """The seaway argument of the kernel: the batch's, or an empty one in calm water."""
-        if self.seaway is not None:
-            return self.seaway.kernel_args()
-        empty = np.zeros((0, 0))
-        return (False, empty, empty, np.zeros(0, dtype=np.uint64), empty, np.zeros((0, 0, 0)),
-                np.zeros(0), 0)  # fmt: skip
+        """The seaway argument of the kernel: the batch's, or the empty one of calm water."""
+        return _CALM_SEAWAY if self.seaway is None else self.seaway.kernel_args()
 
     def set_seaway(self, wind: Any = None, sea_state: Any = None) -> None:
         """Set the wind and sea state of every episode (the env constructors' ``wind`` and

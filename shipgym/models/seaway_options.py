@@ -262,23 +262,26 @@ class SeawayArrays:
             heights = _drawn(sea.significant_height, draws[:, 2], 0.0, 0.0)
             periods = _drawn(sea.peak_period, draws[:, 3], 0.0, 0.0)
             directions = _drawn(sea.direction, draws[:, 4], -math.pi, math.pi)
-            for k, i in enumerate(rows):
-                s[i, sw.S_WAVE_DIR] = self.wf[i, sw.W_WDIR] = directions[k]
-                s[i, sw.S_WAVE_COS] = math.cos(directions[k])
-                s[i, sw.S_WAVE_SIN] = math.sin(directions[k])
-                if heights[k] <= 0.0:
-                    continue
-                ship = self.ship
+            s[rows, sw.S_WAVE_DIR] = self.wf[rows, sw.W_WDIR] = directions
+            s[rows, sw.S_WAVE_COS] = np.cos(directions)
+            s[rows, sw.S_WAVE_SIN] = np.sin(directions)
+            wavy = heights > 0.0
+            at_sea, heights, periods = rows[wavy], heights[wavy], periods[wavy]
+            self.wf[at_sea, sw.W_HS] = heights
+            self.wf[at_sea, sw.W_TP] = periods
+            s[at_sea, sw.S_OMEGA_P] = 2.0 * math.pi / periods
+            s[at_sea, sw.S_SIGMA_ZETA] = heights / 4.0
+            # the tables of each distinct sea (one when the sea is fixed)
+            seas, which = np.unique(np.column_stack((heights, periods)), axis=0,
+                                    return_inverse=True)  # fmt: skip
+            for j, (height, period) in enumerate(seas):
+                same = at_sea[which.ravel() == j]
                 gains, drift, lam = _sea_tables(
-                    float(heights[k]), float(periods[k]), sea.gamma, ship.length, ship.draught
+                    float(height), float(period), sea.gamma, self.ship.length, self.ship.draught
                 )
-                self.gains[i] = gains
-                self.wf[i, sw.W_HS] = heights[k]
-                self.wf[i, sw.W_TP] = periods[k]
-                s[i, sw.S_OMEGA_P] = 2.0 * math.pi / periods[k]
-                s[i, sw.S_LAMBDA] = lam
-                s[i, sw.S_SIGMA_ZETA] = heights[k] / 4.0
-                s[i, sw.S_DRIFT] = drift
+                self.gains[same] = gains
+                s[same, sw.S_LAMBDA] = lam
+                s[same, sw.S_DRIFT] = drift
         self.on = True
 
     def info(self, rows: slice | np.ndarray) -> dict[str, np.ndarray]:
