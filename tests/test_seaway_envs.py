@@ -15,6 +15,7 @@ import shipgym  # noqa: F401  (registers the envs)
 from shipgym.models import seaway as sw
 from shipgym.models import wind as W
 from shipgym.models.angles import ssa
+from shipgym.models.integrate import BLOCK
 from shipgym.models.rvg import CG_FORWARD_OF_AP, GRAVITY, LPP
 from shipgym.models.seaway_options import SeawayArrays, sea_option, wind_option
 from shipgym.models.waves import (
@@ -164,8 +165,9 @@ def _batch(ship: sw.SeawayShip, n: int, nx: int, wind, sea, dt: float, seed: int
 
 def _step(x, c, xm, arrays, rows, dt, advance=True) -> None:
     a = arrays
-    sw.seaway_block(rows, 0, rows.size, x, c, xm, a.sea, a.wf, a.rng, a.tables, a.gains,
-                    a.constants, a.ir, dt, advance)  # fmt: skip
+    for start in range(0, rows.size, BLOCK):
+        sw.seaway_block(rows, start, min(BLOCK, rows.size - start), x, c, xm, a.sea, a.wf, a.rng,
+                        a.tables, a.gains, a.constants, a.ir, dt, advance)  # fmt: skip
 
 
 def test_gusts_have_the_norsok_variance_and_integral_time_scale() -> None:

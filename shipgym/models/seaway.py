@@ -85,8 +85,9 @@ import scipy.integrate
 
 from shipgym.models import wind as _wind
 from shipgym.models._jit import kernel, row_kernel
+from shipgym.models.integrate import BLOCK
 from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, GRAVITY, LPP, WATER_DENSITY
-from shipgym.models.vmath import atan2, sincos
+from shipgym.models.vmath import sincos
 from shipgym.models.waves import SeaState, box_waterline, fit_wave_response, mean_drift_force
 
 __all__ = [
@@ -100,14 +101,21 @@ __all__ = [
     "seaway_block",
     "start_rows",
     "wave_damping",
+    "wave_motion_factors",
     "wave_motion_gains",
+    "wave_motion_table",
 ]
 
 ANGLE_STEP = math.radians(2.0)
 """Spacing [rad] of the tables of wind and drift coefficients over the angle."""
 _ANGLES = np.linspace(-math.pi, math.pi, round(2.0 * math.pi / ANGLE_STEP) + 1)
-#: Encounter angles [rad] of the wave-motion gain tables (every 10 deg).
+#: Encounter angles [rad] of :func:`wave_motion_gains` (every 10 deg).
 GAIN_ANGLES = np.linspace(-math.pi, math.pi, 37)
+WAVE_MOTION_STEP = 0.05
+"""Spacing of :func:`wave_motion_table` in ``u = sqrt(|s|)``."""
+#: Spectrum shapes ``gamma`` of :func:`wave_motion_table`.
+TABLE_GAMMAS = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
+_LAST_U_CELL = round(10.0 / WAVE_MOTION_STEP) - 1.0
 MIN_ENCOUNTER_FREQUENCY = 0.05
 """Lowest encounter frequency [rad/s] of the wave-frequency motion (a following sea that the
 ship nearly rides)."""
@@ -223,30 +231,60 @@ def gust_parameters(mean_speed: np.ndarray, dt: float) -> tuple[np.ndarray, np.n
     return np.where(calm, 0.0, sigma), np.where(calm, 1.0, np.exp(-dt / scale))
 
 
+def wave_motion_factors(gamma: float, s: np.ndarray, points: int = 200) -> np.ndarray:
+    """``(2, len(s))`` spectral RMS factors ``F_xi(s)`` and ``F_psi(s)`` of the wave-frequency
+    displacement and yaw (module docstring) in a sea of spectrum shape ``gamma``, at
+    ``s = kappa cos(beta)``, ``kappa = omega_p^2 L / (2 g)``.
+
+    With ``x = omega / omega_p`` and the sea's normalised spectrum ``w(x)`` (a function of
+    ``gamma`` alone)::
+
+        F_xi(s)  = sqrt(sum w(x) sinc(s x^2)^2),
+        F_psi(s) = sign(s) sqrt(sum w(x) j1(s x^2)^2),
+
+    ``sinc(z) = sin(z) / z`` and ``j1(z) = sin(z) / z^2 - cos(z) / z`` (the spherical Bessel
+    function). The yaw's sign is the long-wave limit's (``sin 2 beta``).
+    """
+    sea = SeaState(1.0, 2.0 * math.pi, 0.0, gamma)  # omega_p = 1: w is the frequency ratio x
+    x = np.linspace(4.0 / points, 4.0, points)
+    weight = sea.spectrum(x)
+    weight = weight / weight.sum()
+    s = np.asarray(s, dtype=np.float64)
+    z = (x * x)[:, None] * s.ravel()[None, :]
+    small = np.abs(z) < 1e-6
+    safe = np.where(small, 1.0, z)
+    sinc = np.where(small, 1.0, np.sin(safe) / safe)
+    j1 = np.where(small, z / 3.0, np.sin(safe) / safe**2 - np.cos(safe) / safe)
+    factors = np.stack((np.sqrt(weight @ (sinc * sinc)), np.sqrt(weight @ (j1 * j1))))
+    factors[1] *= np.sign(s.ravel())
+    return factors.reshape((2, *s.shape))
+
+
 def wave_motion_gains(sea_state: SeaState, length: float, points: int = 200) -> np.ndarray:
     """``(2, 37)`` RMS displacement along the wave direction and signed RMS yaw per metre of
     ``sigma_zeta`` [m/m, rad/m] over the encounter angles :data:`GAIN_ANGLES` (module
-    docstring), for a ship of waterline length ``length`` [m] in ``sea_state``.
-
-    The yaw's sign is that of its in-phase part with the long-wave limit (``sin 2 beta``).
+    docstring), for a ship of waterline length ``length`` [m] in ``sea_state``: ``4 F_xi`` and
+    ``4 (6 / L) sin(beta) F_psi`` of :func:`wave_motion_factors`.
     """
-    wp = sea_state.peak_frequency
-    w = np.linspace(4.0 * wp / points, 4.0 * wp, points)
-    weight = sea_state.spectrum(w)
-    weight = weight / weight.sum()
-    a = 0.5 * length
-    q = (w * w / GRAVITY)[:, None] * np.cos(GAIN_ANGLES)[None, :]
-    qa = q * a
-    small = np.abs(qa) < 1e-6
-    safe = np.where(small, 1.0, q)
-    xi = np.where(small, 1.0, np.sin(qa) / np.where(small, 1.0, qa))
-    moment = np.where(small, q * a**3 / 1.5, 2.0 * (np.sin(qa) / safe**2 - a * np.cos(qa) / safe))
-    yaw = 12.0 / length**3 * np.sin(GAIN_ANGLES)[None, :] * moment
-    rms_xi = np.sqrt(weight @ (xi * xi))
-    rms_yaw = np.sqrt(weight @ (yaw * yaw)) * np.sign(weight @ yaw)
-    return 4.0 * np.stack((rms_xi, rms_yaw))  # per metre of H_s / 4
+    kappa = sea_state.peak_frequency**2 * length / (2.0 * GRAVITY)
+    factors = wave_motion_factors(sea_state.gamma, kappa * np.cos(GAIN_ANGLES), points)
+    return 4.0 * np.stack((factors[0], 6.0 / length * np.sin(GAIN_ANGLES) * factors[1]))
 
 
+@functools.cache
+def wave_motion_table() -> np.ndarray:
+    """``(2, 7, n)`` :func:`wave_motion_factors` ``F_xi``, ``F_psi`` of the compiled step: at
+    the spectrum shapes ``gamma = 1, 2, ..., 7`` and at ``|s| = u^2`` for ``u = 0,``
+    :data:`WAVE_MOTION_STEP` ``, ..., 10`` (``|s|`` up to 100: waves a hundredth of the ship's
+    length), interpolated linearly in ``u`` and ``gamma`` (to 0.2 % of ``F_xi``'s and 0.4 % of
+    ``F_psi``'s largest value); beyond ``|s| = 100`` the last value."""
+    u = np.arange(round(10.0 / WAVE_MOTION_STEP) + 1) * WAVE_MOTION_STEP
+    return np.ascontiguousarray(
+        np.stack([wave_motion_factors(gamma, u * u) for gamma in TABLE_GAMMAS], axis=1)
+    )
+
+
+@functools.cache
 def wave_damping(gamma: float) -> float:
     """Fossen's fitted damping ``lambda`` of the sea's spectrum shape ``gamma``."""
     return fit_wave_response(SeaState(1.0, 10.0, 0.0, gamma))[0]
@@ -255,12 +293,14 @@ def wave_damping(gamma: float) -> float:
 # ---------------------------------------------------------------------------------------------
 # The compiled step. Per ship: ``sea[i]`` its parameters (column names below), ``wf[i]`` its
 # states, ``rng[i]`` its noise stream; ``tables`` the ship's wind and drift tables (6, m),
-# ``gains[i]`` its wave-motion gains (2, 37), ``ship`` its constants.
+# ``gains`` the wave-motion factors of every ship and sea (:func:`wave_motion_table`), ``ship``
+# the ship's constants.
 
 #: Columns of a ship's seaway parameters (set at a reset).
 (S_WIND, S_WIND_COS, S_WIND_SIN, S_GUST_SIGMA, S_GUST_A, S_GUST_B, S_WAVE_COS, S_WAVE_SIN,
- S_OMEGA_P, S_LAMBDA, S_SIGMA_ZETA, S_DRIFT, S_WAVE_DIR) = range(13)  # fmt: skip
-N_SEA = 13
+ S_OMEGA_P, S_LAMBDA, S_TURN, S_HEIGHT, S_YAW_SCALE, S_KAPPA, S_GAMMA_CELL, S_GAMMA_FRAC, S_DRIFT,
+ S_WAVE_DIR) = range(18)  # fmt: skip
+N_SEA = 18
 #: Columns of a ship's seaway states: gust, the AR(2) process now and before, the wave motion
 #: (north, east, heading, yaw rate), the wind speed of the moment and, beside it for the
 #: ``info`` of the envs (one copy), the direction the wind comes from and the sea state
@@ -273,7 +313,17 @@ _MAX_DECAY = 1.5
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
-_S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
+_S30, _S27, _S31, _S32 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(32)
+_LOW32 = np.uint64(0xFFFFFFFF)
+_TO_UNIT = 1.0 / 4294967296.0
+#: ``atan(t) = t (A0 + A1 t^2 + ... + A9 t^18)`` on ``[0, 1]`` (least squares, 9e-10 rad)
+_A0, _A1, _A2, _A3, _A4, _A5, _A6, _A7, _A8, _A9 = (
+    0.9999999805603236, -0.33333180376586213, 0.19996436803571857, -0.14247222580264035,
+    0.10878009426150732, -0.08213760239590584, 0.0550280760678616, -0.028490751047078246,
+    0.009567326687664702, -0.0015093000979699259,
+)  # fmt: skip
+#: ``1 / k!``, the Taylor coefficients of the exponential
+_E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9, _E10 = (1.0 / math.factorial(k) for k in range(11))
 _SQRT12 = math.sqrt(12.0)
 _TWO_PI = 2.0 * math.pi
 #: ``(v + _ROUND) - _ROUND`` rounds ``|v| < 2^51`` to the nearest integer (no library call)
@@ -282,20 +332,24 @@ _ROUND = 6755399441055744.0
 
 @row_kernel
 def noise(rng, i):
-    """The next unit-variance uniform number of ship ``i``'s SplitMix64 stream ``rng[i]``."""
+    """The next two unit-variance uniform numbers of ship ``i``'s SplitMix64 stream ``rng[i]``
+    (the high and the low 32 bits of one draw)."""
     z = rng[i] + _GOLDEN
     rng[i] = z
     z = (z ^ (z >> _S30)) * _MIX1
     z = (z ^ (z >> _S27)) * _MIX2
     z = z ^ (z >> _S31)
-    return _SQRT12 * (np.float64(z >> _S11) * (1.0 / 9007199254740992.0) - 0.5)
+    hi = np.float64(z >> _S32) * _TO_UNIT
+    lo = np.float64(z & _LOW32) * _TO_UNIT
+    return _SQRT12 * (hi - 0.5), _SQRT12 * (lo - 0.5)
 
 
 @row_kernel
 def normal(rng, i):
     """A standard normal number from ship ``i``'s stream (Box-Muller; for the resets)."""
-    u1 = noise(rng, i) / _SQRT12 + 0.5
-    u2 = noise(rng, i) / _SQRT12 + 0.5
+    n1, n2 = noise(rng, i)
+    u1 = n1 / _SQRT12 + 0.5
+    u2 = n2 / _SQRT12 + 0.5
     return math.sqrt(-2.0 * math.log(1.0 - u1)) * math.cos(_TWO_PI * u2)
 
 
@@ -304,19 +358,19 @@ def _exp_neg(z):
     """``exp(-z)`` for ``0 <= z <= 1.5`` to 1e-12 relative, straight-line (the Taylor series of
     ``exp(-z / 4)`` to the 10th power, squared twice)."""
     q = -0.25 * z
-    e = 1.0 + q * (1.0 + q / 2.0 * (1.0 + q / 3.0 * (1.0 + q / 4.0 * (1.0 + q / 5.0 * (
-        1.0 + q / 6.0 * (1.0 + q / 7.0 * (1.0 + q / 8.0 * (1.0 + q / 9.0 * (
-            1.0 + q / 10.0)))))))))  # fmt: skip
+    e = _E0 + q * (_E1 + q * (_E2 + q * (_E3 + q * (_E4 + q * (_E5 + q * (_E6 + q * (
+        _E7 + q * (_E8 + q * (_E9 + q * _E10)))))))))  # fmt: skip
     e *= e
     return e * e
 
 
 @row_kernel
-def ar2_coefficients(lam, we, dt):
+def ar2_coefficients(lam, turn, we, dt):
     """``(rho, cos theta, sin theta, s)`` of the unit-variance AR(2) wave process (module
-    docstring) of damping ``lam`` at the encounter frequency ``we`` [rad/s], step ``dt`` [s]."""
+    docstring) of damping ``lam`` (``turn = sqrt(1 - lam^2)``) at the encounter frequency
+    ``we`` [rad/s], step ``dt`` [s]."""
     rho = _exp_neg(min(lam * we * dt, _MAX_DECAY))
-    st, ct = sincos(min(we * math.sqrt(1.0 - lam * lam) * dt, 3.0))
+    st, ct = sincos(min(we * turn * dt, 3.0))
     r2 = rho * rho
     p2 = 1.0 + r2
     return rho, ct, st, math.sqrt((1.0 - r2) * (p2 * p2 - 4.0 * r2 * ct * ct) / p2)
@@ -341,6 +395,33 @@ def _cell(angle, cells):
 
 
 @row_kernel
+def _bilerp(table, row, j, g, k, f):
+    """``table[row]`` at the float cells ``j + g`` (axis 1) and ``k + f`` (axis 2)."""
+    a, c = int(j), int(k)
+    lo = table[row, a, c] + f * (table[row, a, c + 1] - table[row, a, c])
+    hi = table[row, a + 1, c] + f * (table[row, a + 1, c + 1] - table[row, a + 1, c])
+    return lo + g * (hi - lo)
+
+
+@row_kernel
+def _direction_cell(y, x, cells):
+    """:func:`_cell` of the direction ``atan2(y, x)`` of ``(x, y)``, without a library call
+    and with one division: ``atan`` of the smaller over the larger of ``|x|``, ``|y|`` is an
+    odd polynomial of degree 19 (least squares, 9e-10 rad at most), then C's quadrant rules
+    (``atan2(0, -1) = pi``; a zero vector has direction 0)."""
+    ax = abs(x)
+    ay = abs(y)
+    big = max(ax, ay)
+    t = min(ax, ay) / (big if big > 0.0 else 1.0)
+    z = t * t
+    a = t * (_A0 + z * (_A1 + z * (_A2 + z * (_A3 + z * (_A4 + z * (_A5 + z * (_A6 + z * (
+        _A7 + z * (_A8 + z * _A9)))))))))  # fmt: skip
+    a = 0.5 * math.pi - a if ay > ax else a
+    a = math.pi - a if x < 0.0 else a
+    return _cell(a if y >= 0.0 else -a, cells)
+
+
+@row_kernel
 def _lerp(table, row, k, f):
     """``table[row]`` between cells ``k`` (a float from :func:`_cell`) and ``k + 1``."""
     j = int(k)
@@ -353,9 +434,10 @@ def _lerp(table, row, k, f):
 # ship's numbers into the columns of ``work``; compute the sines, cosines, arctangents and the
 # AR(2) coefficients of every ship in one loop of straight-line arithmetic (the long chains of
 # dependent operations that one ship at a time waits on); then look the tables up and scatter.
-(_PSI, _U, _V, _CN, _CE, _WCOS, _WSIN, _WDIR, _WP, _LAM, _WIND, _WINDC, _WINDS, _GA, _GB, _G,
- _Y, _YP, _N1, _N2, _WE, _QUAD, _KG, _FG, _KB, _FB, _KW, _FW, _Q, _SPEED) = range(30)  # fmt: skip
-_WORK_ROWS = 30
+(_PSI, _U, _V, _CN, _CE, _WCOS, _WSIN, _WDIR, _WP, _LAM, _TURN, _KAPPA, _WIND, _WINDC, _WINDS,
+ _GA, _GB, _G, _Y, _YP, _N1, _N2, _WE, _QUAD, _KU, _FU, _YAW_DIR, _KB, _FB, _KW, _FW, _Q,
+ _SPEED) = range(33)  # fmt: skip
+_WORK_ROWS = 33
 
 
 @row_kernel
@@ -373,6 +455,8 @@ def _gather(rows, start, n, x, c, sea, wf, rng, advance, work):
         work[_WDIR, b] = sea[i, S_WAVE_DIR]
         work[_WP, b] = sea[i, S_OMEGA_P]
         work[_LAM, b] = sea[i, S_LAMBDA]
+        work[_TURN, b] = sea[i, S_TURN]
+        work[_KAPPA, b] = sea[i, S_KAPPA]
         work[_WIND, b] = sea[i, S_WIND]
         work[_WINDC, b] = sea[i, S_WIND_COS]
         work[_WINDS, b] = sea[i, S_WIND_SIN]
@@ -381,14 +465,13 @@ def _gather(rows, start, n, x, c, sea, wf, rng, advance, work):
         work[_G, b] = wf[i, W_GUST]
         work[_Y, b] = wf[i, W_Y]
         work[_YP, b] = wf[i, W_Y_PREV]
-        work[_N1, b] = noise(rng, i) if advance else 0.0
-        work[_N2, b] = noise(rng, i) if advance else 0.0
+        work[_N1, b], work[_N2, b] = noise(rng, i) if advance else (0.0, 0.0)
 
 
 @row_kernel
-def _motion(n, nomoto, dt, advance, cells, gain_cells, work):
+def _motion(n, nomoto, dt, advance, cells, work):
     """Every ship's wave process, gust, apparent wind and the table cells of its encounter and
-    apparent wind angles (``cells`` and ``gain_cells`` of the load and gain tables):
+    apparent wind angles (``cells`` of the load tables), and the wave-motion table's cell:
     straight-line code on ``work``."""
     keep = 1.0 if advance else 0.0
     three_dof = 0.0 if nomoto else 1.0
@@ -402,7 +485,7 @@ def _motion(n, nomoto, dt, advance, cells, gain_cells, work):
         ur = work[_U, b] - three_dof * uc  # a 3-DOF ship's surge is over ground
         cos_beta = work[_WCOS, b] * cs + work[_WSIN, b] * sn
         we = encounter_peak(work[_WP, b], ur, cos_beta)
-        rho, ct, st, s = ar2_coefficients(work[_LAM, b], we, dt)
+        rho, ct, st, s = ar2_coefficients(work[_LAM, b], work[_TURN, b], we, dt)
         y0 = work[_Y, b]
         yp0 = work[_YP, b]
         y = keep * (2.0 * rho * ct * y0 - rho * rho * yp0 + s * work[_N1, b]) + (1.0 - keep) * y0
@@ -426,9 +509,14 @@ def _motion(n, nomoto, dt, advance, cells, gain_cells, work):
         work[_WE, b] = we
         work[_QUAD, b] = (rho * yp - y * ct) / st
         beta = work[_WDIR, b] - work[_PSI, b]
-        work[_KG, b], work[_FG, b] = _cell(beta, gain_cells)
+        sin_beta = work[_WSIN, b] * cs - work[_WCOS, b] * sn
+        work[_YAW_DIR, b] = sin_beta if cos_beta >= 0.0 else -sin_beta  # sin(beta) sign(s)
+        t = math.sqrt(work[_KAPPA, b] * abs(cos_beta)) * (1.0 / WAVE_MOTION_STEP)
+        k = min(max((t - 0.5 + _ROUND) - _ROUND, 0.0), _LAST_U_CELL)  # floor(t) (see _cell)
+        work[_KU, b] = k
+        work[_FU, b] = min(t - k, 1.0)
         work[_KB, b], work[_FB, b] = _cell(beta, cells)
-        work[_KW, b], work[_FW, b] = _cell(atan2(-ay, -ax), cells)
+        work[_KW, b], work[_FW, b] = _direction_cell(-ay, -ax, cells)
         work[_Q, b] = on * 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay)
 
 
@@ -439,11 +527,10 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
     for b in range(n):
         i = rows[start + b]
         y = work[_Y, b]
-        sz = sea[i, S_SIGMA_ZETA]
-        kg, fg, kb, fb, kw, fw = (work[_KG, b], work[_FG, b], work[_KB, b], work[_FB, b],
-                                  work[_KW, b], work[_FW, b])  # fmt: skip
-        xi = sz * _lerp(gains[i], 0, kg, fg) * y
-        gy = sz * _lerp(gains[i], 1, kg, fg)
+        kb, fb, kw, fw = work[_KB, b], work[_FB, b], work[_KW, b], work[_FW, b]
+        jg, fg, ku, fu = sea[i, S_GAMMA_CELL], sea[i, S_GAMMA_FRAC], work[_KU, b], work[_FU, b]
+        xi = sea[i, S_HEIGHT] * _bilerp(gains, 0, jg, fg, ku, fu) * y
+        gy = sea[i, S_YAW_SCALE] * work[_YAW_DIR, b] * _bilerp(gains, 1, jg, fg, ku, fu)
         north = xi * sea[i, S_WAVE_COS]
         east = xi * sea[i, S_WAVE_SIN]
         psi_w = gy * work[_QUAD, b]
@@ -478,20 +565,21 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
 
 @row_kernel
 def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir, dt, advance):
-    """The seaway of ships ``rows[start:start + n]`` after a step (``advance``) or at a reset
+    """The seaway of ships ``rows[start:start + n]`` (``n <= BLOCK``) after a step (``advance``) or at a reset
     (module docstring).
 
     Advances their wave processes and gusts on a step; sets their measured states ``xm``
     (``x`` plus the wave-frequency motion: north, east, heading and, at ``ir``, yaw rate) and
     their loads of the coming step, ``c[:, 2:5]``, from the states now. ``sea``, ``wf`` and
     ``rng`` are the ships' parameters, states and noise streams, ``tables`` the ship's wind
-    and drift coefficients (6 rows), ``gains`` the ships' wave-motion gains, ``ship`` its
+    and drift coefficients (6 rows), ``gains`` :func:`wave_motion_table`, ``ship`` its
     :meth:`SeawayShip.constants`. A ship's result does not depend on the others'.
     """
-    work = np.empty((_WORK_ROWS, n))
+    if n > BLOCK:
+        raise ValueError("seaway_block takes at most BLOCK ships at a time")
+    work = np.empty((_WORK_ROWS, BLOCK))  # its row stride a constant: the passes vectorise
     _gather(rows, start, n, x, c, sea, wf, rng, advance, work)
-    cells, gain_cells = tables.shape[1] - 1.0, gains.shape[2] - 1.0
-    _motion(n, ship[0] == NOMOTO_KIND, dt, advance, cells, gain_cells, work)
+    _motion(n, ship[0] == NOMOTO_KIND, dt, advance, tables.shape[1] - 1.0, work)
     _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work)
 
 
@@ -507,7 +595,7 @@ def start_rows(rows, x, c, sea, wf, rng, dt):
             ur -= c[i, 0] * cs + c[i, 1] * sn
         cos_beta = sea[i, S_WAVE_COS] * cs + sea[i, S_WAVE_SIN] * sn
         we = encounter_peak(sea[i, S_OMEGA_P], ur, cos_beta)
-        rho, ct, _, _ = ar2_coefficients(sea[i, S_LAMBDA], we, dt)
+        rho, ct, _, _ = ar2_coefficients(sea[i, S_LAMBDA], sea[i, S_TURN], we, dt)
         lag1 = 2.0 * rho * ct / (1.0 + rho * rho)  # the lag-one correlation
         y = normal(rng, i)
         wf[i, W_Y] = y

@@ -202,12 +202,11 @@ def _drawn(value: Value | None, u: np.ndarray, low: float, high: float) -> np.nd
 
 
 @functools.lru_cache(maxsize=256)
-def _sea_tables(height: float, period: float, gamma: float, length: float, draught: float):
-    """Wave-motion gains, drift factor and damping of a sea for a ship (cached: a fixed sea
-    costs once)."""
+def _drift(height: float, period: float, gamma: float, draught: float) -> float:
+    """The drift factor ``rho g H_s^2 / 16`` times the reflection factor of a sea on a ship of
+    draught ``draught`` (cached: a fixed sea costs once)."""
     sea = SeaState(height, period, 0.0, gamma)
-    drift = WATER_DENSITY * GRAVITY * height**2 / 16.0 * reflection_factor(sea, draught)
-    return sw.wave_motion_gains(sea, length), drift, sw.wave_damping(gamma)
+    return WATER_DENSITY * GRAVITY * height**2 / 16.0 * reflection_factor(sea, draught)
 
 
 class SeawayArrays:
@@ -224,7 +223,7 @@ class SeawayArrays:
         self.sea = np.zeros((n, sw.N_SEA))
         self.wf = np.zeros((n, sw.N_WF))
         self.rng = np.zeros(n, dtype=np.uint64)
-        self.gains = np.zeros((n, 2, sw.GAIN_ANGLES.size))
+        self.gains = sw.wave_motion_table()
         self.tables = np.ascontiguousarray(np.vstack((ship.wind, ship.drift)))
         self.constants = ship.constants()
         self.ir = int(yaw_rate_index)
@@ -241,9 +240,8 @@ class SeawayArrays:
         uniform draws (the noise streams are seeded from the last)."""
         s = self.sea
         s[rows] = 0.0
-        self.gains[rows] = 0.0
         self.wf[rows] = 0.0
-        s[rows, sw.S_OMEGA_P] = 1.0
+        s[rows, sw.S_OMEGA_P] = s[rows, sw.S_TURN] = 1.0  # a calm sea's process: finite
         self.rng[rows] = (draws[:, 5] * 2.0**53).astype(np.uint64)
         if wind is not None:
             speed = _drawn(wind.speed, draws[:, 0], 0.0, 0.0)
@@ -269,19 +267,26 @@ class SeawayArrays:
             at_sea, heights, periods = rows[wavy], heights[wavy], periods[wavy]
             self.wf[at_sea, sw.W_HS] = heights
             self.wf[at_sea, sw.W_TP] = periods
-            s[at_sea, sw.S_OMEGA_P] = 2.0 * math.pi / periods
-            s[at_sea, sw.S_SIGMA_ZETA] = heights / 4.0
-            # the tables of each distinct sea (one when the sea is fixed)
+            omega_p = 2.0 * math.pi / periods
+            length = self.ship.length
+            s[at_sea, sw.S_OMEGA_P] = omega_p
+            s[at_sea, sw.S_HEIGHT] = heights
+            s[at_sea, sw.S_YAW_SCALE] = 6.0 * heights / length
+            s[at_sea, sw.S_KAPPA] = omega_p**2 * length / (2.0 * GRAVITY)
+            # the cell of the sea's spectrum shape in the wave-motion table
+            cell = min(math.floor(sea.gamma - sw.TABLE_GAMMAS[0]), len(sw.TABLE_GAMMAS) - 2)
+            s[at_sea, sw.S_GAMMA_CELL] = cell
+            s[at_sea, sw.S_GAMMA_FRAC] = sea.gamma - sw.TABLE_GAMMAS[cell]
+            lam = sw.wave_damping(sea.gamma)
+            s[at_sea, sw.S_LAMBDA] = lam
+            s[at_sea, sw.S_TURN] = math.sqrt(1.0 - lam * lam)
+            # the drift of each distinct sea (one when the sea is fixed)
             seas, which = np.unique(np.column_stack((heights, periods)), axis=0,
                                     return_inverse=True)  # fmt: skip
             for j, (height, period) in enumerate(seas):
                 same = at_sea[which.ravel() == j]
-                gains, drift, lam = _sea_tables(
-                    float(height), float(period), sea.gamma, self.ship.length, self.ship.draught
-                )
-                self.gains[same] = gains
-                s[same, sw.S_LAMBDA] = lam
-                s[same, sw.S_DRIFT] = drift
+                s[same, sw.S_DRIFT] = _drift(float(height), float(period), sea.gamma,
+                                             self.ship.draught)  # fmt: skip
         self.on = True
 
     def info(self, rows: slice | np.ndarray) -> dict[str, np.ndarray]:
