@@ -87,7 +87,7 @@ from shipgym.models import wind as _wind
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.integrate import BLOCK
 from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, GRAVITY, LPP, WATER_DENSITY
-from shipgym.models.vmath import sincos
+from shipgym.models.vmath import atan_positive, sincos
 from shipgym.models.waves import SeaState, box_waterline, fit_wave_response, mean_drift_force
 
 __all__ = [
@@ -316,14 +316,10 @@ _MIX2 = np.uint64(0x94D049BB133111EB)
 _S30, _S27, _S31, _S32 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(32)
 _LOW32 = np.uint64(0xFFFFFFFF)
 _TO_UNIT = 1.0 / 4294967296.0
-#: ``atan(t) = t (A0 + A1 t^2 + ... + A9 t^18)`` on ``[0, 1]`` (least squares, 9e-10 rad)
-_A0, _A1, _A2, _A3, _A4, _A5, _A6, _A7, _A8, _A9 = (
-    0.9999999805603236, -0.33333180376586213, 0.19996436803571857, -0.14247222580264035,
-    0.10878009426150732, -0.08213760239590584, 0.0550280760678616, -0.028490751047078246,
-    0.009567326687664702, -0.0015093000979699259,
-)  # fmt: skip
 #: ``1 / k!``, the Taylor coefficients of the exponential
-_E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9, _E10 = (1.0 / math.factorial(k) for k in range(11))
+_E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9, _E10 = (
+    1.0 / math.factorial(k) for k in range(11)
+)
 _SQRT12 = math.sqrt(12.0)
 _TWO_PI = 2.0 * math.pi
 #: ``(v + _ROUND) - _ROUND`` rounds ``|v| < 2^51`` to the nearest integer (no library call)
@@ -405,17 +401,13 @@ def _bilerp(table, row, j, g, k, f):
 
 @row_kernel
 def _direction_cell(y, x, cells):
-    """:func:`_cell` of the direction ``atan2(y, x)`` of ``(x, y)``, without a library call
-    and with one division: ``atan`` of the smaller over the larger of ``|x|``, ``|y|`` is an
-    odd polynomial of degree 19 (least squares, 9e-10 rad at most), then C's quadrant rules
-    (``atan2(0, -1) = pi``; a zero vector has direction 0)."""
+    """:func:`_cell` of the direction ``atan2(y, x)`` of ``(x, y)`` (C's quadrant rules;
+    ``atan2(0, -1) = pi``, a zero vector has direction 0), from the arctangent of the smaller
+    of ``|x|``, ``|y|`` over the larger."""
     ax = abs(x)
     ay = abs(y)
     big = max(ax, ay)
-    t = min(ax, ay) / (big if big > 0.0 else 1.0)
-    z = t * t
-    a = t * (_A0 + z * (_A1 + z * (_A2 + z * (_A3 + z * (_A4 + z * (_A5 + z * (_A6 + z * (
-        _A7 + z * (_A8 + z * _A9)))))))))  # fmt: skip
+    a = atan_positive(min(ax, ay) / (big if big > 0.0 else 1.0))
     a = 0.5 * math.pi - a if ay > ax else a
     a = math.pi - a if x < 0.0 else a
     return _cell(a if y >= 0.0 else -a, cells)
@@ -436,8 +428,8 @@ def _lerp(table, row, k, f):
 # dependent operations that one ship at a time waits on); then look the tables up and scatter.
 (_PSI, _U, _V, _CN, _CE, _WCOS, _WSIN, _WDIR, _WP, _LAM, _TURN, _KAPPA, _WIND, _WINDC, _WINDS,
  _GA, _GB, _G, _Y, _YP, _N1, _N2, _WE, _QUAD, _KU, _FU, _YAW_DIR, _KB, _FB, _KW, _FW, _Q,
- _SPEED) = range(33)  # fmt: skip
-_WORK_ROWS = 33
+ _SPEED, _TO_RUDDER, _TO_LEEWAY) = range(35)  # fmt: skip
+_WORK_ROWS = 35
 
 
 @row_kernel
@@ -469,11 +461,12 @@ def _gather(rows, start, n, x, c, sea, wf, rng, advance, work):
 
 
 @row_kernel
-def _motion(n, nomoto, dt, advance, cells, work):
+def _motion(n, ship, dt, advance, cells, work):
     """Every ship's wave process, gust, apparent wind and the table cells of its encounter and
     apparent wind angles (``cells`` of the load tables), and the wave-motion table's cell:
     straight-line code on ``work``."""
     keep = 1.0 if advance else 0.0
+    nomoto = ship[0] == NOMOTO_KIND
     three_dof = 0.0 if nomoto else 1.0
     for b in range(n):
         sn, cs = sincos(work[_PSI, b])
@@ -518,6 +511,11 @@ def _motion(n, nomoto, dt, advance, cells, work):
         work[_KB, b], work[_FB, b] = _cell(beta, cells)
         work[_KW, b], work[_FW, b] = _direction_cell(-ay, -ax, cells)
         work[_Q, b] = on * 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay)
+        if nomoto:  # the factors of the equivalent rudder angle and the leeway
+            u = max(work[_U, b], MIN_NOMOTO_SPEED)
+            qw = 0.5 * WATER_DENSITY * u * ship[3] * ship[3]
+            work[_TO_RUDDER, b] = 1.0 / (ship[1] * qw * u * ship[3])
+            work[_TO_LEEWAY, b] = 1.0 / (-ship[2] * qw)
 
 
 @row_kernel
@@ -541,9 +539,7 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
         fy = drift * _lerp(tables, 4, kb, fb) + q * _lerp(tables, 1, kw, fw)
         fn = drift * _lerp(tables, 5, kb, fb) + q * _lerp(tables, 2, kw, fw)
         if ship[0] == NOMOTO_KIND:  # the equivalent rudder angle and the leeway
-            u = max(x[i, 3], MIN_NOMOTO_SPEED)
-            qw = 0.5 * WATER_DENSITY * u * ship[3] * ship[3]
-            fx, fy, fn = fn / (ship[1] * qw * u * ship[3]), fy / (-ship[2] * qw), 0.0
+            fx, fy, fn = fn * work[_TO_RUDDER, b], fy * work[_TO_LEEWAY, b], 0.0
         wf[i, W_Y] = y
         wf[i, W_Y_PREV] = work[_YP, b]
         wf[i, W_GUST] = work[_G, b]
@@ -565,8 +561,8 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
 
 @row_kernel
 def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir, dt, advance):
-    """The seaway of ships ``rows[start:start + n]`` (``n <= BLOCK``) after a step (``advance``) or at a reset
-    (module docstring).
+    """The seaway of ships ``rows[start:start + n]`` (``n <= BLOCK``) after a step
+    (``advance``) or at a reset (module docstring).
 
     Advances their wave processes and gusts on a step; sets their measured states ``xm``
     (``x`` plus the wave-frequency motion: north, east, heading and, at ``ir``, yaw rate) and
@@ -579,7 +575,7 @@ def seaway_block(rows, start, n, x, c, xm, sea, wf, rng, tables, gains, ship, ir
         raise ValueError("seaway_block takes at most BLOCK ships at a time")
     work = np.empty((_WORK_ROWS, BLOCK))  # its row stride a constant: the passes vectorise
     _gather(rows, start, n, x, c, sea, wf, rng, advance, work)
-    _motion(n, ship[0] == NOMOTO_KIND, dt, advance, tables.shape[1] - 1.0, work)
+    _motion(n, ship, dt, advance, tables.shape[1] - 1.0, work)
     _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work)
 
 
