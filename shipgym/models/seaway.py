@@ -52,8 +52,13 @@ Wave-frequency motion
         psi / zeta_a = 12 sin(beta) / L^3 * 2 (sin(q a) / q^2 - a cos(q a) / q),
 
     the yaw in quadrature with the displacement (``-> k sin(beta) cos(beta)``, half the wave
-    slope at 45 deg, in long waves). Their spectral RMS per metre of ``sigma_zeta = H_s / 4``
-    is tabulated over ``beta`` for each ship's sea (:func:`wave_motion_gains`). The time
+    slope at 45 deg, in long waves). With ``q a = s x^2``, ``x = omega / omega_p`` and
+    ``s = kappa cos(beta)``, ``kappa = omega_p^2 L / (2 g)``, the yaw is ``6 sin(beta) / L``
+    times the spherical Bessel function ``j1(q a)``, and the spectral RMS of both per metre
+    of ``sigma_zeta = H_s / 4`` are ``G_xi = 4 F_xi(s)`` and ``G_psi = 4 (6 / L) sin(beta)
+    F_psi(s)``: the factors ``F`` depend on the spectrum's shape ``gamma`` and on ``s`` alone,
+    so one table serves every ship and sea (:func:`wave_motion_factors`,
+    :func:`wave_motion_table`; :func:`wave_motion_gains` over ``beta``). The time
     series is one unit-variance AR(2) process per ship with the poles of Fossen's linear
     wave response model (:mod:`shipgym.models.waves`) at the encounter peak frequency
     ``omega_e = |omega_p - omega_p^2 U cos(beta) / g|`` of the moment (at least
@@ -69,7 +74,8 @@ Wave-frequency motion
 
 Noise
     Each ship's white noise comes from its own SplitMix64 stream (Steele, Lea and Flood 2014),
-    seeded from its episode's draws: unit-variance uniform numbers ``sqrt(12) (u - 1/2)``,
+    seeded from its episode's draws, one draw a step: its high and low 32 bits are two
+    unit-variance uniform numbers ``sqrt(12) (u - 1/2)``,
     which the slow filters above turn into Gaussian processes (central limit). A ship's
     disturbances do not depend on the other ships of its batch.
 """
@@ -421,10 +427,11 @@ def _lerp(table, row, k, f):
 
 
 # The seaway of a block of ships in three passes. A loop over ships vectorises (SIMD code) only
-# if it reads and writes the columns of a small table by the ship's place in the block: it must
-# not gather (a row chosen by ``rows``, a table cell chosen by an angle). So: gather each
-# ship's numbers into the columns of ``work``; compute the sines, cosines, arctangents and the
-# AR(2) coefficients of every ship in one loop of straight-line arithmetic (the long chains of
+# if it reads and writes the columns of a small table of constant shape (so that its rows
+# cannot overlap) by the ship's place in the block: it must not gather (a row chosen by
+# ``rows``, a table cell chosen by an angle). So: gather each ship's numbers into the columns
+# of ``work``; compute the sines, cosines, arctangents, square roots and the AR(2)
+# coefficients of every ship in one loop of straight-line arithmetic (the long chains of
 # dependent operations that one ship at a time waits on); then look the tables up and scatter.
 (_PSI, _U, _V, _CN, _CE, _WCOS, _WSIN, _WDIR, _WP, _LAM, _TURN, _KAPPA, _WIND, _WINDC, _WINDS,
  _GA, _GB, _G, _Y, _YP, _N1, _N2, _WE, _QUAD, _KU, _FU, _YAW_DIR, _KB, _FB, _KW, _FW, _Q,
@@ -520,7 +527,7 @@ def _motion(n, ship, dt, advance, cells, work):
 
 @row_kernel
 def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
-    """Look the block's ships' wave-motion gains, drift and wind coefficients up, and write
+    """Look the block's ships' wave-motion factors, drift and wind coefficients up, and write
     their states, loads and measured states."""
     for b in range(n):
         i = rows[start + b]

@@ -238,55 +238,63 @@ class SeawayArrays:
     ) -> None:
         """Set the seaway of ``rows`` from the options and their ``(len(rows), N_DRAWS)``
         uniform draws (the noise streams are seeded from the last)."""
-        s = self.sea
-        s[rows] = 0.0
-        self.wf[rows] = 0.0
-        s[rows, sw.S_OMEGA_P] = s[rows, sw.S_TURN] = 1.0  # a calm sea's process: finite
-        self.rng[rows] = (draws[:, 5] * 2.0**53).astype(np.uint64)
+        k = len(rows)
+        s = np.zeros((sw.N_SEA, k))  # the rows' parameters and states, set at once below
+        w = np.zeros((sw.N_WF, k))
+        s[sw.S_OMEGA_P] = s[sw.S_TURN] = 1.0  # a calm sea's process: finite
         if wind is not None:
             speed = _drawn(wind.speed, draws[:, 0], 0.0, 0.0)
-            s[rows, sw.S_WIND] = speed
+            s[sw.S_WIND] = speed
             direction = _drawn(wind.direction, draws[:, 1], -math.pi, math.pi)
-            self.wf[rows, sw.W_FROM] = direction
-            s[rows, sw.S_WIND_COS] = np.cos(direction)
-            s[rows, sw.S_WIND_SIN] = np.sin(direction)
-            s[rows, sw.S_GUST_A] = 1.0
+            w[sw.W_FROM] = direction
+            s[sw.S_WIND_COS] = np.cos(direction)
+            s[sw.S_WIND_SIN] = np.sin(direction)
+            s[sw.S_GUST_A] = 1.0
             if wind.gusts:
                 sigma, a = sw.gust_parameters(speed, self.dt)
-                s[rows, sw.S_GUST_SIGMA] = sigma
-                s[rows, sw.S_GUST_A] = a
-                s[rows, sw.S_GUST_B] = sigma * np.sqrt(1.0 - a * a)
+                s[sw.S_GUST_SIGMA] = sigma
+                s[sw.S_GUST_A] = a
+                s[sw.S_GUST_B] = sigma * np.sqrt(1.0 - a * a)
         if sea is not None:
             heights = _drawn(sea.significant_height, draws[:, 2], 0.0, 0.0)
             periods = _drawn(sea.peak_period, draws[:, 3], 0.0, 0.0)
-            directions = _drawn(sea.direction, draws[:, 4], -math.pi, math.pi)
-            s[rows, sw.S_WAVE_DIR] = self.wf[rows, sw.W_WDIR] = directions
-            s[rows, sw.S_WAVE_COS] = np.cos(directions)
-            s[rows, sw.S_WAVE_SIN] = np.sin(directions)
-            wavy = heights > 0.0
-            at_sea, heights, periods = rows[wavy], heights[wavy], periods[wavy]
-            self.wf[at_sea, sw.W_HS] = heights
-            self.wf[at_sea, sw.W_TP] = periods
-            omega_p = 2.0 * math.pi / periods
+            s[sw.S_WAVE_DIR] = w[sw.W_WDIR] = _drawn(sea.direction, draws[:, 4], -math.pi, math.pi)
+            s[sw.S_WAVE_COS] = np.cos(s[sw.S_WAVE_DIR])
+            s[sw.S_WAVE_SIN] = np.sin(s[sw.S_WAVE_DIR])
+            wavy: slice | np.ndarray = heights > 0.0
+            if wavy.all():
+                wavy = slice(None)  # (cheaper than a mask)
+            else:
+                heights, periods = heights[wavy], periods[wavy]
             length = self.ship.length
-            s[at_sea, sw.S_OMEGA_P] = omega_p
-            s[at_sea, sw.S_HEIGHT] = heights
-            s[at_sea, sw.S_YAW_SCALE] = 6.0 * heights / length
-            s[at_sea, sw.S_KAPPA] = omega_p**2 * length / (2.0 * GRAVITY)
+            omega_p = 2.0 * math.pi / periods
+            lam = sw.wave_damping(sea.gamma)
             # the cell of the sea's spectrum shape in the wave-motion table
             cell = min(math.floor(sea.gamma - sw.TABLE_GAMMAS[0]), len(sw.TABLE_GAMMAS) - 2)
-            s[at_sea, sw.S_GAMMA_CELL] = cell
-            s[at_sea, sw.S_GAMMA_FRAC] = sea.gamma - sw.TABLE_GAMMAS[cell]
-            lam = sw.wave_damping(sea.gamma)
-            s[at_sea, sw.S_LAMBDA] = lam
-            s[at_sea, sw.S_TURN] = math.sqrt(1.0 - lam * lam)
-            # the drift of each distinct sea (one when the sea is fixed)
-            seas, which = np.unique(np.column_stack((heights, periods)), axis=0,
-                                    return_inverse=True)  # fmt: skip
-            for j, (height, period) in enumerate(seas):
-                same = at_sea[which.ravel() == j]
-                s[same, sw.S_DRIFT] = _drift(float(height), float(period), sea.gamma,
-                                             self.ship.draught)  # fmt: skip
+            if isinstance(sea.significant_height, tuple) or isinstance(sea.peak_period, tuple):
+                drift = np.array([_drift(float(h), float(t), sea.gamma, self.ship.draught)
+                                  for h, t in zip(heights, periods, strict=True)])  # fmt: skip
+            else:  # one sea
+                drift = _drift(float(sea.significant_height), float(sea.peak_period), sea.gamma,
+                               self.ship.draught)  # fmt: skip
+            columns = {
+                sw.S_OMEGA_P: omega_p,
+                sw.S_LAMBDA: lam,
+                sw.S_TURN: math.sqrt(1.0 - lam * lam),
+                sw.S_HEIGHT: heights,
+                sw.S_YAW_SCALE: 6.0 * heights / length,
+                sw.S_KAPPA: omega_p**2 * length / (2.0 * GRAVITY),
+                sw.S_GAMMA_CELL: cell,
+                sw.S_GAMMA_FRAC: sea.gamma - sw.TABLE_GAMMAS[cell],
+                sw.S_DRIFT: drift,
+            }
+            for column, value in columns.items():
+                s[column, wavy] = value
+            w[sw.W_HS, wavy] = heights
+            w[sw.W_TP, wavy] = periods
+        self.sea[rows] = s.T
+        self.wf[rows] = w.T
+        self.rng[rows] = (draws[:, 5] * 2.0**53).astype(np.uint64)
         self.on = True
 
     def info(self, rows: slice | np.ndarray) -> dict[str, np.ndarray]:
