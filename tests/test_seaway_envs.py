@@ -170,6 +170,15 @@ def _step(x, c, xm, arrays, rows, dt, advance=True) -> None:
                         a.tables, a.gains, a.constants, a.ir, dt, advance)  # fmt: skip
 
 
+def test_a_block_of_more_ships_than_its_scratch_holds_is_refused() -> None:
+    """The block kernel's scratch holds BLOCK ships; a longer block is refused, not overrun."""
+    x, c, xm, arrays, rows = _batch(sw.gunnerus_seaway(), BLOCK + 1, 10, {"speed": 8.0}, None, 1.0)
+    a = arrays
+    with pytest.raises(ValueError, match="at most BLOCK ships"):
+        sw.seaway_block(rows, 0, rows.size, x, c, xm, a.sea, a.wf, a.rng, a.tables, a.gains,
+                        a.constants, a.ir, 1.0, True)  # fmt: skip
+
+
 def test_gusts_have_the_norsok_variance_and_integral_time_scale() -> None:
     """The gust process's variance is NORSOK's spectrum integrated, and its lag-one
     correlation exp(-dt / T) with T = S(0) / (4 sigma^2), the spectrum's integral time scale
