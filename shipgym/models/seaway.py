@@ -93,7 +93,7 @@ from shipgym.models import wind as _wind
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.integrate import BLOCK
 from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, GRAVITY, LPP, WATER_DENSITY
-from shipgym.models.vmath import atan_positive, sincos
+from shipgym.models.vmath import atan_unit, sincos
 from shipgym.models.waves import SeaState, box_waterline, fit_wave_response, mean_drift_force
 
 __all__ = [
@@ -413,7 +413,7 @@ def _direction_cell(y, x, cells):
     ax = abs(x)
     ay = abs(y)
     big = max(ax, ay)
-    a = atan_positive(min(ax, ay) / (big if big > 0.0 else 1.0))
+    a = atan_unit(min(ax, ay) / (big if big > 0.0 else 1.0))
     a = 0.5 * math.pi - a if ay > ax else a
     a = math.pi - a if x < 0.0 else a
     return _cell(a if y >= 0.0 else -a, cells)
@@ -475,6 +475,9 @@ def _motion(n, ship, dt, advance, cells, work):
     keep = 1.0 if advance else 0.0
     nomoto = ship[0] == NOMOTO_KIND
     three_dof = 0.0 if nomoto else 1.0
+    if nomoto:  # (the constants of the equivalent rudder angle and the leeway)
+        rudder_per_load = 1.0 / (ship[1] * ship[3])
+        leeway_per_load = -1.0 / ship[2]
     for b in range(n):
         sn, cs = sincos(work[_PSI, b])
         cn = work[_CN, b]
@@ -520,15 +523,16 @@ def _motion(n, ship, dt, advance, cells, work):
         work[_Q, b] = on * 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay)
         if nomoto:  # the factors of the equivalent rudder angle and the leeway
             u = max(work[_U, b], MIN_NOMOTO_SPEED)
-            qw = 0.5 * WATER_DENSITY * u * ship[3] * ship[3]
-            work[_TO_RUDDER, b] = 1.0 / (ship[1] * qw * u * ship[3])
-            work[_TO_LEEWAY, b] = 1.0 / (-ship[2] * qw)
+            per_qu = 1.0 / (0.5 * WATER_DENSITY * u * u * ship[3] * ship[3])  # 1 / (qw u)
+            work[_TO_RUDDER, b] = rudder_per_load * per_qu
+            work[_TO_LEEWAY, b] = leeway_per_load * u * per_qu
 
 
 @row_kernel
 def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
     """Look the block's ships' wave-motion factors, drift and wind coefficients up, and write
     their states, loads and measured states."""
+    nomoto = ship[0] == NOMOTO_KIND
     for b in range(n):
         i = rows[start + b]
         y = work[_Y, b]
@@ -536,17 +540,18 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
         jg, fg, ku, fu = sea[i, S_GAMMA_CELL], sea[i, S_GAMMA_FRAC], work[_KU, b], work[_FU, b]
         xi = sea[i, S_HEIGHT] * _bilerp(gains, 0, jg, fg, ku, fu) * y
         gy = sea[i, S_YAW_SCALE] * work[_YAW_DIR, b] * _bilerp(gains, 1, jg, fg, ku, fu)
-        north = xi * sea[i, S_WAVE_COS]
-        east = xi * sea[i, S_WAVE_SIN]
+        north = xi * work[_WCOS, b]
+        east = xi * work[_WSIN, b]
         psi_w = gy * work[_QUAD, b]
         r_w = gy * work[_WE, b] * y
         drift = sea[i, S_DRIFT]
         q = work[_Q, b]
-        fx = drift * _lerp(tables, 3, kb, fb) + q * _lerp(tables, 0, kw, fw)
         fy = drift * _lerp(tables, 4, kb, fb) + q * _lerp(tables, 1, kw, fw)
         fn = drift * _lerp(tables, 5, kb, fb) + q * _lerp(tables, 2, kw, fw)
-        if ship[0] == NOMOTO_KIND:  # the equivalent rudder angle and the leeway
+        if nomoto:  # the equivalent rudder angle and the leeway (no surge equation)
             fx, fy, fn = fn * work[_TO_RUDDER, b], fy * work[_TO_LEEWAY, b], 0.0
+        else:
+            fx = drift * _lerp(tables, 3, kb, fb) + q * _lerp(tables, 0, kw, fw)
         wf[i, W_Y] = y
         wf[i, W_Y_PREV] = work[_YP, b]
         wf[i, W_GUST] = work[_G, b]
