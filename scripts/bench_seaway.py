@@ -134,7 +134,7 @@ def plot(results: dict[str, list[dict[str, float | str]]], path: Path) -> Path:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--num-envs", type=int, nargs="+", default=[256, 4096], help="sub-envs of a vector env"
+        "--num-envs", type=int, nargs="+", default=[16, 256, 4096], help="sub-envs of a vector env"
     )
     parser.add_argument(
         "--steps", type=int, default=300, help="steps timed per round (at 256 sub-envs; "
