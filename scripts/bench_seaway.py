@@ -113,7 +113,7 @@ def plot(results: dict[str, list[dict[str, float | str]]], path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 3.2))
+    fig, ax = plt.subplots(figsize=(7.5, 4.0))
     names = [str(r["env"]) for r in next(iter(results.values()))]
     width = 0.8 / len(results)
     for k, (label, rows) in enumerate(results.items()):
@@ -123,7 +123,7 @@ def plot(results: dict[str, list[dict[str, float | str]]], path: Path) -> Path:
     ax.set_xticks(np.arange(len(names)), names, rotation=15, fontsize=8)
     ax.set_ylabel("step at sea / calm step")
     ax.set_title("What wind and waves cost a vector env's step (median of rounds)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.22))
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
