@@ -83,6 +83,27 @@ def test_an_episodes_seaway_is_a_function_of_its_seed() -> None:
     assert not np.array_equal(run(4), run(5))
 
 
+@pytest.mark.parametrize("height", [0.0, (0.0, 3.0)])
+def test_a_flat_sea_moves_nothing_and_a_range_draws_each_ships_sea(height) -> None:
+    """A wave height of 0 (fixed, or drawn from a range that starts at 0) is a sea without
+    waves: no wave motion and no drift; each ship of a range has its own drawn sea."""
+    env = gym.make_vec("shipgym/RVGHeading-v1", num_envs=8, vectorization_mode="vector_entry_point")
+    sea = {"significant_height": height, "peak_period": (5.0, 9.0)}
+    _, info = env.reset(seed=2, options={"sea_state": sea})
+    for _ in range(5):
+        info = env.step(np.zeros((8, 1)))[4]
+    flat = info["sea_state"][:, 0] == 0.0
+    if height == 0.0:
+        assert flat.all()
+    else:
+        assert not flat.any() and np.unique(info["sea_state"][:, 0]).size == 8
+    np.testing.assert_array_equal(info["wave_motion"][flat], 0.0)
+    np.testing.assert_array_equal(info["measured_state"][flat], info["state"][flat])
+    task = env.unwrapped.task
+    np.testing.assert_array_equal(task.c[flat, 2:], 0.0)
+    assert (np.abs(info["wave_motion"][~flat]).max(axis=1) > 0.0).all()
+
+
 def test_calm_draws_are_unchanged_by_a_seaway_option_of_another_reset() -> None:
     """A reset without a seaway draws what it always drew (the seaway's draws come after)."""
     calm = gym.make("shipgym/NomotoHeading-v0")

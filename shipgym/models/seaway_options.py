@@ -274,9 +274,11 @@ class SeawayArrays:
             if isinstance(sea.significant_height, tuple) or isinstance(sea.peak_period, tuple):
                 drift = np.array([_drift(float(h), float(t), sea.gamma, self.ship.draught)
                                   for h, t in zip(heights, periods, strict=True)])  # fmt: skip
-            else:  # one sea
+            elif heights.size:  # one sea
                 drift = _drift(float(sea.significant_height), float(sea.peak_period), sea.gamma,
                                self.ship.draught)  # fmt: skip
+            else:  # a flat sea
+                drift = 0.0
             columns = {
                 sw.S_OMEGA_P: omega_p,
                 sw.S_LAMBDA: lam,
