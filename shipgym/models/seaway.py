@@ -93,7 +93,7 @@ from shipgym.models import wind as _wind
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.integrate import BLOCK
 from shipgym.models.rvg import CG_FORWARD_OF_AP, DRAUGHT, GRAVITY, LPP, WATER_DENSITY
-from shipgym.models.vmath import atan_unit, sincos
+from shipgym.models.vmath import atan2, sincos
 from shipgym.models.waves import SeaState, box_waterline, fit_wave_response, mean_drift_force
 
 __all__ = [
@@ -119,9 +119,11 @@ _ANGLES = np.linspace(-math.pi, math.pi, round(2.0 * math.pi / ANGLE_STEP) + 1)
 GAIN_ANGLES = np.linspace(-math.pi, math.pi, 37)
 WAVE_MOTION_STEP = 0.05
 """Spacing of :func:`wave_motion_table` in ``u = sqrt(|s|)``."""
+#: Its last ``u`` (``|s| = 100``: waves a hundredth of the ship's length).
+_LAST_U = 10.0
 #: Spectrum shapes ``gamma`` of :func:`wave_motion_table`.
 TABLE_GAMMAS = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
-_LAST_U_CELL = round(10.0 / WAVE_MOTION_STEP) - 1.0
+_LAST_U_CELL = round(_LAST_U / WAVE_MOTION_STEP) - 1.0
 MIN_ENCOUNTER_FREQUENCY = 0.05
 """Lowest encounter frequency [rad/s] of the wave-frequency motion (a following sea that the
 ship nearly rides)."""
@@ -170,8 +172,9 @@ class SeawayShip:
     nomoto: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def constants(self) -> np.ndarray:
-        """``[kind, N'_delta, Y'_v, L]``: the ship's constants of the compiled step."""
-        return np.array([float(self.kind), *self.nomoto], dtype=np.float64)
+        """``[kind, N'_delta, Y'_v, L, 6 / length]``: the ship's constants of the compiled
+        step (the last the yaw per unit ``j1`` of the wave-frequency motion)."""
+        return np.array([float(self.kind), *self.nomoto, 6.0 / self.length], dtype=np.float64)
 
 
 def _unit_drift(length: float, beam: float, origin_aft_of_midship: float) -> np.ndarray:
@@ -284,7 +287,7 @@ def wave_motion_table() -> np.ndarray:
     :data:`WAVE_MOTION_STEP` ``, ..., 10`` (``|s|`` up to 100: waves a hundredth of the ship's
     length), interpolated linearly in ``u`` and ``gamma`` (to 0.2 % of ``F_xi``'s and 0.4 % of
     ``F_psi``'s largest value); beyond ``|s| = 100`` the last value."""
-    u = np.arange(round(10.0 / WAVE_MOTION_STEP) + 1) * WAVE_MOTION_STEP
+    u = np.arange(round(_LAST_U / WAVE_MOTION_STEP) + 1) * WAVE_MOTION_STEP
     return np.ascontiguousarray(
         np.stack([wave_motion_factors(gamma, u * u) for gamma in TABLE_GAMMAS], axis=1)
     )
@@ -304,9 +307,9 @@ def wave_damping(gamma: float) -> float:
 
 #: Columns of a ship's seaway parameters (set at a reset).
 (S_WIND, S_WIND_COS, S_WIND_SIN, S_GUST_SIGMA, S_GUST_A, S_GUST_B, S_WAVE_COS, S_WAVE_SIN,
- S_OMEGA_P, S_LAMBDA, S_TURN, S_HEIGHT, S_YAW_SCALE, S_KAPPA, S_GAMMA_CELL, S_GAMMA_FRAC, S_DRIFT,
- S_WAVE_DIR) = range(18)  # fmt: skip
-N_SEA = 18
+ S_OMEGA_P, S_LAMBDA, S_TURN, S_HEIGHT, S_KAPPA, S_GAMMA_CELL, S_GAMMA_FRAC, S_DRIFT,
+ S_WAVE_DIR) = range(17)  # fmt: skip
+N_SEA = 17
 #: Columns of a ship's seaway states: gust, the AR(2) process now and before, the wave motion
 #: (north, east, heading, yaw rate), the wind speed of the moment and, beside it for the
 #: ``info`` of the envs (one copy), the direction the wind comes from and the sea state
@@ -403,20 +406,6 @@ def _bilerp(table, row, j, g, k, f):
     lo = table[row, a, c] + f * (table[row, a, c + 1] - table[row, a, c])
     hi = table[row, a + 1, c] + f * (table[row, a + 1, c + 1] - table[row, a + 1, c])
     return lo + g * (hi - lo)
-
-
-@row_kernel
-def _direction_cell(y, x, cells):
-    """:func:`_cell` of the direction ``atan2(y, x)`` of ``(x, y)`` (C's quadrant rules;
-    ``atan2(0, -1) = pi``, a zero vector has direction 0), from the arctangent of the smaller
-    of ``|x|``, ``|y|`` over the larger."""
-    ax = abs(x)
-    ay = abs(y)
-    big = max(ax, ay)
-    a = atan_unit(min(ax, ay) / (big if big > 0.0 else 1.0))
-    a = 0.5 * math.pi - a if ay > ax else a
-    a = math.pi - a if x < 0.0 else a
-    return _cell(a if y >= 0.0 else -a, cells)
 
 
 @row_kernel
@@ -519,7 +508,7 @@ def _motion(n, ship, dt, advance, cells, work):
         work[_KU, b] = k
         work[_FU, b] = min(t - k, 1.0)
         work[_KB, b], work[_FB, b] = _cell(beta, cells)
-        work[_KW, b], work[_FW, b] = _direction_cell(-ay, -ax, cells)
+        work[_KW, b], work[_FW, b] = _cell(atan2(-ay, -ax), cells)
         work[_Q, b] = on * 0.5 * _wind.RHO_AIR * (ax * ax + ay * ay)
         if nomoto:  # the factors of the equivalent rudder angle and the leeway
             u = max(work[_U, b], MIN_NOMOTO_SPEED)
@@ -538,8 +527,9 @@ def _loads(rows, start, n, x, c, xm, sea, wf, tables, gains, ship, ir, work):
         y = work[_Y, b]
         kb, fb, kw, fw = work[_KB, b], work[_FB, b], work[_KW, b], work[_FW, b]
         jg, fg, ku, fu = sea[i, S_GAMMA_CELL], sea[i, S_GAMMA_FRAC], work[_KU, b], work[_FU, b]
-        xi = sea[i, S_HEIGHT] * _bilerp(gains, 0, jg, fg, ku, fu) * y
-        gy = sea[i, S_YAW_SCALE] * work[_YAW_DIR, b] * _bilerp(gains, 1, jg, fg, ku, fu)
+        height = sea[i, S_HEIGHT]
+        xi = height * _bilerp(gains, 0, jg, fg, ku, fu) * y
+        gy = height * ship[4] * work[_YAW_DIR, b] * _bilerp(gains, 1, jg, fg, ku, fu)
         north = xi * work[_WCOS, b]
         east = xi * work[_WSIN, b]
         psi_w = gy * work[_QUAD, b]

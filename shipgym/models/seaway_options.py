@@ -284,7 +284,6 @@ class SeawayArrays:
                 sw.S_LAMBDA: lam,
                 sw.S_TURN: math.sqrt(1.0 - lam * lam),
                 sw.S_HEIGHT: heights,
-                sw.S_YAW_SCALE: 6.0 * heights / length,
                 sw.S_KAPPA: omega_p**2 * length / (2.0 * GRAVITY),
                 sw.S_GAMMA_CELL: cell,
                 sw.S_GAMMA_FRAC: sea.gamma - sw.TABLE_GAMMAS[cell],

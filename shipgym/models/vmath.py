@@ -18,8 +18,7 @@ rudder angles), NaN for NaN and infinite arguments (where ``math.sin`` would rai
   no ship state reaches it.
 * :func:`atan2`: Cephes' ``atan`` (rational approximation after reduction to ``|t| <= 0.66``
   with ``tan(3 pi/8)`` and ``pi/4`` splits) and the quadrant rules of C's ``atan2`` for finite
-  arguments; :func:`atan_unit` the same ``atan`` on ``[0, 1]`` alone (no ``tan(3 pi/8)``
-  split: SIMD code computes every branch, and each costs a division).
+  arguments.
 """
 
 from __future__ import annotations
@@ -103,19 +102,6 @@ def atan_positive(a):
     num = (((_P0 * z + _P1) * z + _P2) * z + _P3) * z + _P4
     den = ((((z + _Q0) * z + _Q1) * z + _Q2) * z + _Q3) * z + _Q4
     return base + ((t * (z * num / den) + t) + extra)
-
-
-@row_kernel
-def atan_unit(a):
-    """``atan(a)`` for ``0 <= a <= 1``: :func:`atan_positive` without its branch for large
-    ``a`` (one division fewer in SIMD code, which computes every branch)."""
-    mid = a > 0.66
-    t = (a - 1.0) / (a + 1.0) if mid else a
-    z = t * t
-    num = (((_P0 * z + _P1) * z + _P2) * z + _P3) * z + _P4
-    den = ((((z + _Q0) * z + _Q1) * z + _Q2) * z + _Q3) * z + _Q4
-    return (0.25 * math.pi if mid else 0.0) + ((t * (z * num / den) + t) + (
-        0.5 * _MOREBITS if mid else 0.0))  # fmt: skip
 
 
 @row_kernel
