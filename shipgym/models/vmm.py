@@ -38,7 +38,11 @@ Named term sets (:data:`TERM_SETS`): ``linear``; ``abkowitz`` (Abkowitz's third-
 expansion with thrust, the seed's AVMM), ``martin`` and ``martin_simple`` (the seed's simplified
 models; the latter is its MAVMM), as in the seed author's ``VesselManoeuvringModels``
 (``vmm_linear``, ``vmm_abkowitz``, ``vmm_martin``, ``vmm_martin_simple``); ``norrbin3``
-(Norrbin's second-order modulus terms). The author's ``linear`` set has no thrust term and
+(Norrbin's second-order modulus terms); ``mmg_hull``, ``martin_simple`` with the hull
+polynomial of the MMG standard method (Yasukawa and Yoshimura 2015 eq. 7-9: ``X_vv v'^2``,
+``X_vvvv v'^4`` and the cubic sway and yaw terms ``vvv, vvr, vrr, rrr`` of ``Y`` and ``N``;
+the MMG coefficients, scaled by ``d / L`` for the VMM's ``L^2`` reference area, are values of
+these terms). The author's ``linear`` set has no thrust term and
 linearised rigid-body equations; here it keeps ``X_T T'`` (without it no straight-running
 equilibrium exists) and the full rigid-body terms.
 
@@ -136,6 +140,12 @@ TERM_SETS: dict[str, tuple[str, ...]] = {
     "martin_simple": (
         *_X,
         *(f"{e}_{t}" for e in "YN" for t in ("v", "r", "u", "ur", "d", "Td", "T", "vvd")),
+    ),
+    "mmg_hull": (
+        *_X, "X_vv", "X_vvvv",
+        *(f"{e}_{t}" for e in "YN" for t in (
+            "v", "r", "vvv", "vvr", "vrr", "rrr", "u", "ur", "d", "Td", "T", "vvd",
+        )),
     ),
     "norrbin3": (
         "X_u", "X_uu", "X_vv", "X_vr", "X_rr", "X_dd", "X_T",
