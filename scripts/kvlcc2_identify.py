@@ -24,6 +24,11 @@ Usage::
    beside the measurement and the published-coefficient MMG model (``docs/kvlcc2_simman.json``).
 4. **Esso Osaka.** The identification loop on all 15 pond runs, whose records carry the apparent
    wind.
+5. **MARIN, every pair of zigzags held out.** ``identify MARIN_*.dat --model vmm:auto`` holds
+   out the -10 and 20 deg zigzags and chooses the term set on them; each of the six pairs of
+   the four zigzags is held out here in turn (the base model of every term set fitted on the
+   other four runs, scored as ``vmm:auto`` scores it), so that the choice is seen not to rest
+   on one split.
 
 Writes ``OUT/kvlcc2_identify.json``, ``OUT/kvlcc2_identify.png`` and the block between
 ``<!-- kvlcc2_identify -->`` and ``<!-- /kvlcc2_identify -->`` of ``docs/results/kvlcc2.md``.
@@ -38,7 +43,7 @@ import math
 import sys
 import time
 import warnings
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -67,7 +72,7 @@ VMM_EFFECTS = ("asymmetry",)
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_ROOT = measured_root()  # $SHIPGYM_MEASURED_DATA, else where shipgym data fetch puts it
-TERM_SETS = ("linear", "martin_simple", "martin", "norrbin3")
+TERM_SETS = ("linear", "martin_simple", "martin", "norrbin3", "mmg_hull")
 SCORE_LENGTHS = 15.0  # scoring windows in ship lengths of travel (the family's default)
 MARIN_WINDOW_S = 300.0
 
@@ -232,6 +237,36 @@ def _trials_of(
     return rows
 
 
+def _marin_pairs(marin: list[Any]) -> list[dict[str, Any]]:
+    """Held-out heading RMS [deg] of the base model of every term set on each pair of MARIN
+    zigzags, fitted on the other four runs as ``vmm:auto`` fits and scores it (inf: the model
+    runs away on a held-out or training run)."""
+    from itertools import combinations
+
+    from shipgym.sysid.families.base import FAMILIES
+
+    family = FAMILIES["vmm:auto"]
+    ctx = family.prepare(marin, 0.3, "auto")
+    zigzags = [i for i, r in enumerate(marin) if "_zz_" in r.meta["file"]]
+    tasks = [(list(pair), ts) for pair in combinations(zigzags, 2) for ts in TERM_SETS]
+
+    def score(task: tuple[list[int], str]) -> float:
+        held, term_set = task
+        train = [i for i in range(len(marin)) if i not in held]
+        cand = family._candidate(replace(ctx, term_set=term_set, held=held, train=train), ())
+        return math.degrees(cand.heldout_rms["psi"]) if cand.heldout_rms else math.inf
+
+    with ThreadPoolExecutor(max_workers=2) as pool:  # the replay kernel releases the GIL
+        psi = list(pool.map(score, tasks))
+    rows: dict[tuple[int, ...], dict[str, Any]] = {}
+    for (held, term_set), value in zip(tasks, psi, strict=True):
+        name = " + ".join(Path(marin[i].meta["file"]).name.removeprefix("MARIN_FREE_KVLCC2_")
+                          .removesuffix("_m.dat") for i in held)  # fmt: skip
+        rows.setdefault(tuple(held), {"held_out": name, "psi_rms_deg": {}})
+        rows[tuple(held)]["psi_rms_deg"][term_set] = value
+    return list(rows.values())
+
+
 def _fit_all(records: list[Any], term_set: str) -> Any:
     template, runs, _, shoot = _setup(records, None)
     return fv.fit_vmm(runs, template, term_set, VMM_EFFECTS, rp=shoot)
@@ -319,9 +354,14 @@ def main(argv: list[str] | None = None) -> int:
         others = [r for j, r in enumerate(marin) if j != i]
         fit = _fit_all(others, best)
         trial = _trial(Path(rec.meta["file"]))
-        tc = maneuvers.turning_circle(make_model("vmm", fit.params), trial["a"], trial["side"])
+        try:
+            tc = maneuvers.turning_circle(make_model("vmm", fit.params), trial["a"],
+                                          trial["side"])  # fmt: skip
+            td_vmm, advance_vmm = tc.tactical_diameter, tc.advance
+        except ValueError:  # a model fitted on the other side's turn only may run away
+            td_vmm = advance_vmm = None
         meas = simman.get(rec.meta["file"], {}).get("measured", {})
-        row.update(tactical_diameter_vmm=tc.tactical_diameter, advance_vmm=tc.advance,
+        row.update(tactical_diameter_vmm=td_vmm, advance_vmm=advance_vmm,
                    tactical_diameter_measured=meas.get("tactical_diameter"),
                    advance_measured=meas.get("advance"),
                    tactical_diameter_mmg=simman.get(rec.meta["file"], {}).get("model", {})
@@ -329,7 +369,15 @@ def main(argv: list[str] | None = None) -> int:
         marin_rows.append(row)
         _say(
             f"  {row['run']}: psi {row['psi_rms_deg']:.2f} deg in {MARIN_WINDOW_S:g} s windows; "
-            f"TD {tc.tactical_diameter:.0f} m (measured {meas.get('tactical_diameter', 0):.0f})"
+            f"TD {_f(td_vmm, '.0f')} m (measured {meas.get('tactical_diameter', 0):.0f})"
+        )
+
+    _say("MARIN: every pair of zigzags predicted from the other runs ...")
+    marin_pairs = _marin_pairs(marin)
+    for row in marin_pairs:
+        _say(
+            f"  {row['held_out']}: "
+            + ", ".join(f"{k} {v:.2f}" for k, v in row["psi_rms_deg"].items())
         )
 
     _say("the MMG model refined on every run of each facility ...")
@@ -364,6 +412,7 @@ def main(argv: list[str] | None = None) -> int:
         "loop_s": loop_s,
         "loop_effects": loop.effect_names,
         "marin": marin_rows,
+        "marin_zigzag_pairs": marin_pairs,
         "mmg_refined": {
             name: {"factors": fit.factors, "stderr": fit.stderr, "at_bound": fit.at_bound}
             for name, fit in mmg.items()
@@ -419,10 +468,42 @@ def render(doc: dict[str, Any]) -> str:
     for r in doc["marin"]:
         lines.append(
             f"| {r['run'].removeprefix('MARIN_FREE_KVLCC2_').removesuffix('_m.dat')} | "
-            f"{r['psi_rms_deg']:.2f} | {_f(r['tactical_diameter_vmm'], '.0f')} / "
+            f"{_f(r['psi_rms_deg'], '.2f')} | {_f(r['tactical_diameter_vmm'], '.0f')} / "
             f"{_f(r['tactical_diameter_measured'], '.0f')} / "
             f"{_f(r['tactical_diameter_mmg'], '.0f')} |"
         )
+    away = [r for r in doc["marin"] if r["tactical_diameter_vmm"] is None
+            or not math.isfinite(r["psi_rms_deg"])]  # fmt: skip
+    if away:
+        lines += ["", f"A dash: the model fitted without that turn runs away in it ({len(away)} "
+                  f"of {len(doc['marin'])}); fitted on one side's turn only, `{best}` "
+                  "extrapolates its turning terms to the other side."]  # fmt: skip
+    pairs = doc.get("marin_zigzag_pairs", [])
+    if pairs:
+        sets = list(pairs[0]["psi_rms_deg"])
+        wins = {ts: sum(min(p["psi_rms_deg"], key=p["psi_rms_deg"].get) == ts for p in pairs)
+                for ts in sets}  # fmt: skip
+        lines += [
+            "",
+            "MARIN, every pair of the four zigzags held out in turn (the base model of each "
+            "term set fitted on the other four runs and scored as `vmm:auto` scores it; "
+            "`identify MARIN_*.dat --model vmm:auto` holds out the first pair and chooses "
+            "its term set there). Held-out heading RMS [deg], a dash where the model runs away:",
+            "",
+            "| held out | " + " | ".join(f"`{ts}`" for ts in sets) + " |",
+            "|---|" + "---:|" * len(sets),
+        ]
+        for p in pairs:
+            best_ts = min(p["psi_rms_deg"], key=p["psi_rms_deg"].get)
+            lines.append(f"| {p['held_out']} | " + " | ".join(
+                (f"**{_f(v, '.2f')}**" if ts == best_ts else _f(v, ".2f"))
+                for ts, v in p["psi_rms_deg"].items()) + " |")  # fmt: skip
+        lines += [
+            "",
+            "Lowest on a pair: "
+            + ", ".join(f"`{ts}` {n} of {len(pairs)}" for ts, n in wins.items() if n)
+            + ".",
+        ]
     zz = [t for t in doc["trials"] if t["kind"] == "zigzag" and t.get("measured")
           and "overshoot1_deg" in t.get("vmm", {})]  # fmt: skip
     if zz:
@@ -469,7 +550,7 @@ def render(doc: dict[str, Any]) -> str:
 
 
 def plot(doc: dict[str, Any], path: Path) -> None:
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8), constrained_layout=True)
+    fig, axes = plt.subplots(1, 4, figsize=(21, 4.8), constrained_layout=True)
     ax = axes[0]
     runs = [r["run"].removeprefix("HSVA_CPMC_KVLCC2_Z_").removesuffix(".dat") for r in doc["hsva"]]
     x = np.arange(len(runs))
@@ -505,7 +586,7 @@ def plot(doc: dict[str, Any], path: Path) -> None:
     x = np.arange(len(names))
     ax.bar(x - 0.27, [r["tactical_diameter_measured"] or np.nan for r in doc["marin"]], 0.27,
            label="measured")  # fmt: skip
-    ax.bar(x, [r["tactical_diameter_vmm"] for r in doc["marin"]], 0.27,
+    ax.bar(x, [r["tactical_diameter_vmm"] or np.nan for r in doc["marin"]], 0.27,
            label="VMM, other runs")  # fmt: skip
     ax.bar(x + 0.27, [r["tactical_diameter_mmg"] or np.nan for r in doc["marin"]], 0.27,
            label="MMG, published")  # fmt: skip
@@ -513,6 +594,24 @@ def plot(doc: dict[str, Any], path: Path) -> None:
     ax.set_ylabel("tactical diameter [m]")
     ax.set_title("MARIN 35 deg turning circles")
     ax.legend(fontsize=8)
+    ax = axes[3]
+    pairs = doc.get("marin_zigzag_pairs", [])
+    if pairs:
+        sets = list(pairs[0]["psi_rms_deg"])
+        x = np.arange(len(pairs))
+        width = 0.8 / len(sets)
+        for k, ts in enumerate(sets):
+            values = [p["psi_rms_deg"][ts] for p in pairs]
+            ax.bar(
+                x + (k - (len(sets) - 1) / 2) * width,
+                [v if math.isfinite(v) else np.nan for v in values],
+                width,
+                label=ts,
+            )
+        ax.set_xticks(x, [p["held_out"].replace(" + ", "\n") for p in pairs], fontsize=8)
+        ax.set_ylabel("held-out heading RMS [deg]")
+        ax.set_title("MARIN: each pair of zigzags predicted")
+        ax.legend(fontsize=8)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
