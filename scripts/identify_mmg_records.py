@@ -267,8 +267,8 @@ def render(doc: dict[str, Any]) -> str:
     n = doc["n_seeds"]
     lines = [
         f"The 3-DOF loop (`{doc['model']}`) on runs of the KVLCC2 L7 model made by the MMG "
-        f"standard model ({SIMULATOR_NAMES[doc.get('simulator', 'shipgym')]}), a structure its "
-        f"polynomials do not share: {doc['n_runs']} runs of "
+        f"standard model ({SIMULATOR_NAMES[doc.get('simulator', 'shipgym')]}), whose rudder and "
+        f"propeller forces its polynomials do not share: {doc['n_runs']} runs of "
         "90-120 s (10/10 and 20/20 zigzags and 35 deg turns to both sides) with noise on every "
         f"channel and one undeclared effect, {n} seed{'s' if n != 1 else ''} each; held out "
         f"(the default hold-out): {_held(doc)}. "

@@ -137,8 +137,9 @@ effect's influence on the signals.
 Several runs of one 3-DOF ship, for the multi-run families (``vmm:<term set>``):
 :func:`generate_vmm_runs` simulates a known VMM (its own polynomials, with ``current``, ``wind``
 or ``rudder_slipstream``); :func:`generate_mmg_runs` simulates the KVLCC2 L7 tank model with the
-MMG standard model (Yasukawa and Yoshimura 2015, :mod:`shipgym.models.mmg`), a structure the VMM
-polynomials do not share, with one of ``rudder_offset``, ``rudder_lag``, ``input_delay``,
+MMG standard model (Yasukawa and Yoshimura 2015, :mod:`shipgym.models.mmg`), whose rudder and
+propeller forces the VMM polynomials do not share (the ``mmg_hull`` term set holds its hull
+polynomial), with one of ``rudder_offset``, ``rudder_lag``, ``input_delay``,
 ``current`` and ``wind`` (Blendermann's loads, :mod:`shipgym.models.wind`), as short runs as a
 tank gives, noise on every channel and the ship's main particulars as plain meta keys.
 """
@@ -1056,7 +1057,7 @@ def generate_vmm_runs(
 
 
 # --------------------------------------------------------------------------------------------
-# 3-DOF model tests: runs of the MMG KVLCC2, a structure the VMM polynomials do not share
+# 3-DOF model tests: runs of the MMG KVLCC2, whose rudder and propeller the VMM does not share
 
 
 MMG_EFFECTS: tuple[str, ...] = ("rudder_offset", "rudder_lag", "input_delay", "current", "wind")
