@@ -504,6 +504,8 @@ def _replay_kernel(
     X0 = np.ascontiguousarray(np.column_stack(x0)[:, pick])
     out = np.empty((t_len, pick.size, X0.shape[0]))
     d0s = np.asarray(d0, dtype=np.float64)[pick]
+    # contiguous, as the kernel is compiled (a thinned record's rudder is a strided view)
+    delta, speed, n_cmd, h = (np.ascontiguousarray(a) for a in (delta, speed, n_cmd, h))
     _REPLAY_KERNELS[model_id](X0, delta, d0s, speed, n_cmd, h, P, out)
     return out[:, : len(p)]
 

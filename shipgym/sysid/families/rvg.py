@@ -503,6 +503,8 @@ def _replay(
     P = np.ascontiguousarray(np.column_stack(packed)[:, pick])
     P.flags.writeable = False
     out = np.empty((time.size, pick.size, 10))
+    # contiguous, as the kernel is compiled (a thinned record's channels are strided views)
+    time, meas, rpm, az = (np.ascontiguousarray(a) for a in (time, meas, rpm, az))
     _windows_kernel(
         time, meas, rpm, az, np.asarray(starts, dtype=np.int64), P,
         disturbance_block(np.asarray(current, dtype=np.float64)[pick]),
@@ -710,6 +712,8 @@ def _residuals_of(
     for a variant with a non-finite residual."""
     rows = np.flatnonzero(mask)
     out = np.empty((sims.shape[1], 6 * rows.size))
+    # contiguous, as the kernel is compiled (the variants of a padded replay are a slice)
+    sims, meas = np.ascontiguousarray(sims), np.ascontiguousarray(meas)
     _residual_kernel(sims, meas, rows, np.asarray(sigma, dtype=np.float64), out)
     return out
 
