@@ -433,6 +433,12 @@ def _f(x: Any, fmt: str = ".1f") -> str:
     return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, fmt)
 
 
+def _table_head(first: str, columns: list[str]) -> list[str]:
+    """A markdown table's header and rule: ``first``, then the ``columns`` as code."""
+    return ["| " + " | ".join([first, *(f"`{c}`" for c in columns)]) + " |",
+            "|---|" + "---:|" * len(columns)]  # fmt: skip
+
+
 def render(doc: dict[str, Any]) -> str:
     best = doc["best_term_set"]
     lines = [
@@ -481,8 +487,7 @@ def render(doc: dict[str, Any]) -> str:
     pairs = doc.get("marin_zigzag_pairs", [])
     if pairs:
         sets = list(pairs[0]["psi_rms_deg"])
-        wins = {ts: sum(min(p["psi_rms_deg"], key=p["psi_rms_deg"].get) == ts for p in pairs)
-                for ts in sets}  # fmt: skip
+        lowest = [min(p["psi_rms_deg"], key=p["psi_rms_deg"].get) for p in pairs]
         lines += [
             "",
             "MARIN, every pair of the four zigzags held out in turn (the base model of each "
@@ -490,20 +495,14 @@ def render(doc: dict[str, Any]) -> str:
             "`identify MARIN_*.dat --model vmm:auto` holds out the first pair and chooses "
             "its term set there). Held-out heading RMS [deg], a dash where the model runs away:",
             "",
-            "| held out | " + " | ".join(f"`{ts}`" for ts in sets) + " |",
-            "|---|" + "---:|" * len(sets),
+            *_table_head("held out", sets),
         ]
-        for p in pairs:
-            best_ts = min(p["psi_rms_deg"], key=p["psi_rms_deg"].get)
+        for p, best_ts in zip(pairs, lowest, strict=True):
             lines.append(f"| {p['held_out']} | " + " | ".join(
                 (f"**{_f(v, '.2f')}**" if ts == best_ts else _f(v, ".2f"))
                 for ts, v in p["psi_rms_deg"].items()) + " |")  # fmt: skip
-        lines += [
-            "",
-            "Lowest on a pair: "
-            + ", ".join(f"`{ts}` {n} of {len(pairs)}" for ts, n in wins.items() if n)
-            + ".",
-        ]
+        wins = [f"`{ts}` {lowest.count(ts)} of {len(pairs)}" for ts in sets if ts in lowest]
+        lines += ["", "Lowest on a pair: " + ", ".join(wins) + "."]
     zz = [t for t in doc["trials"] if t["kind"] == "zigzag" and t.get("measured")
           and "overshoot1_deg" in t.get("vmm", {})]  # fmt: skip
     if zz:
@@ -529,8 +528,7 @@ def render(doc: dict[str, Any]) -> str:
             "same runs (`shipgym identify ... --model kvlcc2`; factors on the published values "
             "with standard errors):",
             "",
-            "| facility | " + " | ".join(f"`{k}`" for k in names) + " |",
-            "|---|" + "---:|" * len(names),
+            *_table_head("facility", names),
         ]
         for name, m in mm.items():
             cells = [f"{m['factors'][k]:.2f} ± {m['stderr'][k]:.3f}" for k in names]
