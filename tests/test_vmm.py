@@ -390,21 +390,25 @@ def test_a_single_screw_ships_turn_asymmetry_is_structure_not_a_rudder_zero_erro
 def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     """``vmm:auto`` fits every term set, and the best again with the single-screw asymmetry as
     structure, keeps the one that predicts the held-out run best, says which and
-    by how much, and goes on with it."""
+    by how much, and goes on with it: the effects of its first round are those the structure
+    did not score already."""
     from shipgym.sysid.families.vmm import VMMAutoFamily, loop_terms
 
-    runs = generate_vmm_runs(None, n_runs=3, seed=4, dt=0.5)
+    runs = generate_vmm_runs(None, n_runs=3, seed=2, dt=0.5)  # a symmetric set wins
     said: list[str] = []
-    result = identify(runs, "vmm:auto", max_effects=0, progress=said.append)
+    result = identify(runs, "vmm:auto", max_effects=1, progress=said.append)
     sel = result.diagnostics["term_set_selection"]
     scores = sel["heldout_error"]
     symmetric = sorted(TERM_SETS, key=scores.__getitem__)
     tries = symmetric[: VMMAutoFamily.ASYMMETRIC_TRIES]
     assert set(scores) == set(TERM_SETS) | {f"{n}+turn_asymmetry" for n in tries}
     assert sel["chosen"] == min(scores, key=scores.__getitem__)
-    assert set(result.parameters_after) == set(loop_terms(sel["chosen"], ()))
+    assert set(result.parameters_after) == set(loop_terms(sel["chosen"], result.effect_names))
     assert any(line.startswith(f"term set {sel['chosen']} (") for line in said)
     assert result.to_dict()["term_set_selection"]["chosen"] == sel["chosen"]
+    # <set>+turn_asymmetry is the base with the effect turn_asymmetry: scored once, as structure
+    assert "+" not in sel["chosen"] and "turn_asymmetry" not in result.rounds[0]
+    assert {"asymmetry", "rudder_offset", "current"} <= set(result.rounds[0])
 
 
 def test_a_model_that_diverges_on_its_own_training_runs_is_no_candidate() -> None:
