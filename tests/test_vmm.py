@@ -428,6 +428,25 @@ def test_a_model_that_diverges_on_its_own_training_runs_is_no_candidate() -> Non
     assert math.isinf(cand.J) and cand.extra["diverges_on"] == "its training runs"
 
 
+def test_a_replay_of_some_windows_is_the_full_replay_on_them() -> None:
+    """A fit on some runs replays only their windows: each window is simulated from its own
+    start, so its samples are those of the full replay, bit for bit; the others are NaN."""
+    from shipgym.sysid.families.base import FAMILIES
+    from shipgym.sysid.families.vmm import _windows_of, replay
+
+    family = FAMILIES["vmm:martin_simple"]
+    ctx = family.prepare(generate_vmm_runs(None, n_runs=3, seed=4, dt=0.5), 0.3, "auto")
+    fit = family._fit(ctx, (), ctx.train, False)
+    rp = ctx.rp_fit
+    windows = _windows_of(rp, ctx.train)
+    assert 0 < windows.size < rp.starts.size
+    full = replay(rp, fit.params, (0.02, -0.01), actuators={"delta0": 0.01})
+    some = replay(rp, fit.params, (0.02, -0.01), actuators={"delta0": 0.01}, windows=windows)
+    train = np.isin(rp.run_of, ctx.train)
+    assert np.array_equal(some[train], full[train]) and np.all(np.isfinite(full))
+    assert np.isnan(some[~train]).all()
+
+
 def test_term_set_names_take_the_single_screw_asymmetry_as_structure() -> None:
     from shipgym.sysid.families.vmm import loop_terms, term_set_terms
 
