@@ -1745,7 +1745,8 @@ class VMMAutoFamily(VMMFamily):
     Every structure is refined in full before it is ranked: ranked after 6 of the 20 cost
     evaluations instead (half the cost), the 60-term Abkowitz set, slower to converge, lost
     to smaller sets that predict worse once all are converged (19 of the 36 MMG-made record
-    sets chose another structure, their median held-out heading error 0.98 -> 1.24 deg).
+    sets chose another structure, their median held-out heading error 0.98 -> 1.24 deg);
+    after 10 it still did, after 40 the ranking is that after 20, every score within 5 %.
     """
 
     #: How many of the best symmetric term sets are tried with :data:`STRUCTURE_EFFECTS`. One:
