@@ -6,14 +6,16 @@ many processes at once from a cold cache (the test suite's workers, Ray workers,
 container) would otherwise compile the same kernels in each of them. This runs the public
 entry points once with the argument types they always get, so the cache holds every kernel:
 
-* ``envs``: every env, single and vector (one step each; the task kernels);
+* ``heading``, ``speed``, ``path_following``, ``target_tracking``: the envs of each task,
+  single and vector (one step each; each task has its own kernel), ``envs`` all four;
 * ``models``: every model's ``simulate``, ``step``, ``deriv`` and ``linearize``, and the
   standard manoeuvres' simulation;
 * ``sysid``: the identification replays of the Nomoto-family fits, the steering-gear lag and
   the R/V Gunnerus model's windows, on short synthetic records.
 
 The parts are independent: ``python -m shipgym.warmup --parallel`` runs them in two processes
-at once, so the next call costs nothing (the test suite does this before its workers start).
+of about equal compile time at once (:data:`PARALLEL_GROUPS`), so the next call costs nothing
+(the test suite does this before its workers start).
 A part that has run leaves a marker in the cache folder, which is keyed by the kernels' content
 (:data:`shipgym.models._jit.CACHE_DIR`): :func:`cold_parts` tells which parts a run would have
 to compile, and :func:`compile_estimate_s` about how long that takes
@@ -23,6 +25,7 @@ the parts it needs (:data:`BENCHMARK_GROUPS`).
 
 from __future__ import annotations
 
+import functools
 import os
 import subprocess
 import sys
@@ -46,13 +49,24 @@ __all__ = [
 ]
 
 
-def _envs() -> None:
+#: The env tasks (:data:`shipgym.envs.TASKS`) of each env part of the warm-up.
+ENV_PARTS: dict[str, tuple[str, ...]] = {
+    "heading": ("NomotoHeading", "RVGHeading"),
+    "speed": ("RVGSpeed",),
+    "path_following": ("RVGPathFollowing",),
+    "target_tracking": ("RVGTargetTracking",),
+}
+#: What ``envs`` stands for: every env part.
+ENVS = tuple(ENV_PARTS)
+
+
+def _envs(tasks: Sequence[str]) -> None:
     import gymnasium as gym
 
     import shipgym  # noqa: F401 (registers the envs)
-    from shipgym.envs import ENV_IDS
+    from shipgym.envs import ENV_IDS, env_task
 
-    for env_id in ENV_IDS:
+    for env_id in (i for i in ENV_IDS if env_task(i) in tasks):
         env = gym.make(env_id)
         env.reset(seed=0)
         env.step(env.action_space.sample())
@@ -92,8 +106,12 @@ def _sysid() -> None:
     replay_windows(rvg, make_model("rvg3dof").params, window_starts(rvg.time, 10.0))
 
 
-PARTS: dict[str, Callable[[], None]] = {"envs": _envs, "models": _models, "sysid": _sysid}
-"""The parts of the warm-up by name."""
+PARTS: dict[str, Callable[[], None]] = {
+    **{part: functools.partial(_envs, tasks) for part, tasks in ENV_PARTS.items()},
+    "models": _models,
+    "sysid": _sysid,
+}
+"""The parts of the warm-up by name (``envs`` stands for :data:`ENVS`)."""
 
 
 def _marker(part: str) -> Path | None:
@@ -103,16 +121,29 @@ def _marker(part: str) -> Path | None:
     return Path(CACHE_DIR) / f"warmup-{part}.done" if CACHE_DIR else None
 
 
-def _check(parts: Sequence[str]) -> None:
-    unknown = [p for p in parts if p not in PARTS]
+def _expand(parts: Sequence[str]) -> list[str]:
+    """``parts`` with ``envs`` written out (:data:`ENVS`), each once, in order.
+
+    Raises
+    ------
+    ValueError
+        For a name that is neither a part nor ``envs``.
+    """
+    unknown = [p for p in parts if p not in PARTS and p != "envs"]
     if unknown:
-        raise ValueError(f"unknown warm-up part(s) {unknown}; expected any of {list(PARTS)}")
+        raise ValueError(
+            f"unknown warm-up part(s) {unknown}; expected any of {[*PARTS, 'envs']}"
+        )
+    out: list[str] = []
+    for part in parts:
+        out += [p for p in (ENVS if part == "envs" else (part,)) if p not in out]
+    return out
 
 
 def warm(parts: Sequence[str] = tuple(PARTS), say: Callable[[str], None] = print) -> None:
-    """Run the warm-up ``parts`` (names of :data:`PARTS`) in this process and mark each warm."""
-    _check(parts)
-    for part in parts:
+    """Run the warm-up ``parts`` (names of :data:`PARTS`, or ``envs``) in this process and mark
+    each warm."""
+    for part in _expand(parts):
         t0 = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -125,22 +156,38 @@ def warm(parts: Sequence[str] = tuple(PARTS), say: Callable[[str], None] = print
 
 
 def cold_parts(parts: Sequence[str] = tuple(PARTS)) -> list[str]:
-    """The ``parts`` whose kernels are not in the cache yet (all of them without a cache)."""
-    _check(parts)
-    return [p for p in parts if (marker := _marker(p)) is None or not marker.exists()]
+    """The ``parts`` (``envs`` written out) whose kernels are not in the cache yet (all of
+    them without a cache)."""
+    return [p for p in _expand(parts) if (marker := _marker(p)) is None or not marker.exists()]
 
 
-#: Seconds of one core to compile each part from a cold cache, each part in its own process:
-#: ``SHIPGYM_CACHE_DIR=<empty folder> python -m shipgym.warmup <part>`` on one core of a
-#: two-vCPU AMD EPYC virtual machine, measured 2026-11-27 (Numba 0.68.1), ``envs`` and
-#: ``sysid`` as the test suite runs them, side by side in two processes (wall time of each).
-COLD_COMPILE_S: dict[str, float] = {"envs": 91.0, "models": 24.0, "sysid": 51.0}
+#: Seconds of one core to compile each part from a cold cache, each part in a process of its
+#: own or after the parts before it in its group: ``SHIPGYM_CACHE_DIR=<empty folder> python -m
+#: shipgym.warmup <part>`` and the groups below, on a two-vCPU AMD EPYC virtual machine,
+#: measured 2026-11-27 (Numba 0.68.1). Where a process that runs at the same time compiled a
+#: kernel first, the part loads it instead: in :data:`PARALLEL_GROUPS` ``models`` takes 0.5 s,
+#: as ``sysid`` compiles the model kernels it shares.
+COLD_COMPILE_S: dict[str, float] = {
+    "heading": 35.0,
+    "speed": 16.5,
+    "path_following": 18.0,
+    "target_tracking": 17.0,
+    "models": 21.0,
+    "sysid": 49.0,
+}
 
 #: The parts split in processes of about equal compile time.
-PARALLEL_GROUPS: tuple[tuple[str, ...], ...] = (("envs", "models"), ("sysid",))
+PARALLEL_GROUPS: tuple[tuple[str, ...], ...] = (
+    ("heading", "speed", "path_following", "models"),
+    ("sysid", "target_tracking"),
+)
 
-#: The parts ``shipgym benchmark`` needs (envs and the models' linearisations), one process each.
-BENCHMARK_GROUPS: tuple[tuple[str, ...], ...] = (("envs",), ("models",))
+#: The parts ``shipgym benchmark`` needs (the envs and the models' linearisations), in two
+#: processes of about equal compile time.
+BENCHMARK_GROUPS: tuple[tuple[str, ...], ...] = (
+    ("heading", "speed"),
+    ("path_following", "target_tracking", "models"),
+)
 
 
 def compile_estimate_s(

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from shipgym import warmup
+
 # compiles one small kernel from the cache folder given in the environment
 _RUN = (
     "import warnings, numpy as np\n"
@@ -97,7 +99,7 @@ def test_the_warm_up_fills_the_cache_that_later_processes_and_copies_load(tmp_pa
     assert bad.returncode == 2 and "unknown warm-up part(s) ['kernels']" in bad.stderr
     parts = "from shipgym.warmup import cold_parts; print(*cold_parts())"
     empty = run("-c", parts, SHIPGYM_CACHE_DIR=str(tmp_path / "empty"))
-    assert empty.stdout.split() == ["envs", "models", "sysid"], empty.stderr
+    assert empty.stdout.split() == list(warmup.PARTS), empty.stderr
     warm = run("-c", parts)
     assert warm.returncode == 0 and warm.stdout.split() == [], warm.stderr
     later = run("-c", _SIMULATE)

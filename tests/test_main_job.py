@@ -130,19 +130,34 @@ def test_throughput_judges_only_runs_on_an_idle_machine(monkeypatch: pytest.Monk
 # ------------------------------------------------------------------------------------------
 def test_compile_estimate_from_the_measured_parts(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(warmup, "cold_parts", lambda parts=tuple(warmup.PARTS): list(parts))
-    envs, models, sysid = (warmup.COLD_COMPILE_S[p] for p in ("envs", "models", "sysid"))
-    groups = (("envs",), ("models",))
+    heading, models = (warmup.COLD_COMPILE_S[p] for p in ("heading", "models"))
+    groups = (("heading",), ("models",))
     # two processes on two idle cores: the longer one; on one core: one after the other
-    assert warmup.compile_estimate_s(groups, cpus=2, other_load=0.0) == max(envs, models)
-    assert warmup.compile_estimate_s(groups, cpus=1, other_load=0.0) == envs + models
+    assert warmup.compile_estimate_s(groups, cpus=2, other_load=0.0) == max(heading, models)
+    assert warmup.compile_estimate_s(groups, cpus=1, other_load=0.0) == heading + models
     # two other busy processes on two cores: each compiling process gets half a core
-    assert warmup.compile_estimate_s(groups, cpus=2, other_load=2.0) == 2 * max(envs, models)
+    assert warmup.compile_estimate_s(groups, cpus=2, other_load=2.0) == 2 * max(heading, models)
     every = warmup.compile_estimate_s(cpus=2, other_load=0.0)
-    assert every == max(envs + models, sysid)
-    monkeypatch.setattr(warmup, "cold_parts", lambda parts=(): [p for p in parts if p != "envs"])
-    assert warmup.compile_estimate_s(groups, cpus=2, other_load=0.0) == models  # envs warm
+    assert every == max(sum(warmup.COLD_COMPILE_S[p] for p in g) for g in warmup.PARALLEL_GROUPS)
+    monkeypatch.setattr(warmup, "cold_parts", lambda parts=(): [p for p in parts if p != "heading"])
+    assert warmup.compile_estimate_s(groups, cpus=2, other_load=0.0) == models  # heading warm
     with pytest.raises(ValueError, match="other_load must be >= 0"):
         warmup.compile_estimate_s(groups, cpus=2, other_load=-1.0)
+
+
+def test_the_warm_up_parts_cover_every_env_task_once_and_envs_stands_for_them() -> None:
+    from shipgym.envs import TASKS
+
+    tasks = [t for part in warmup.ENVS for t in warmup.ENV_PARTS[part]]
+    assert sorted(tasks) == sorted(TASKS)
+    groups = [p for g in warmup.PARALLEL_GROUPS for p in g]
+    assert sorted(groups) == sorted(warmup.PARTS)  # the test suite warms every part once
+    bench = [p for g in warmup.BENCHMARK_GROUPS for p in g]
+    assert sorted(bench) == sorted([*warmup.ENVS, "models"])
+    # envs written out, each part once, in order
+    assert warmup._expand(["models", "envs", "speed"]) == ["models", *warmup.ENVS]
+    with pytest.raises(ValueError, match=r"unknown warm-up part\(s\) \['kernels'\]"):
+        warmup.cold_parts(["kernels"])
 
 
 # ------------------------------------------------------------------------------------------
