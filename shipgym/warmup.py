@@ -39,6 +39,8 @@ import numpy as np
 __all__ = [
     "BENCHMARK_GROUPS",
     "COLD_COMPILE_S",
+    "ENVS",
+    "ENV_PARTS",
     "PARALLEL_GROUPS",
     "PARTS",
     "cold_parts",
@@ -164,9 +166,9 @@ def cold_parts(parts: Sequence[str] = tuple(PARTS)) -> list[str]:
 #: Seconds of one core to compile each part from a cold cache, each part in a process of its
 #: own or after the parts before it in its group: ``SHIPGYM_CACHE_DIR=<empty folder> python -m
 #: shipgym.warmup <part>`` and the groups below, on a two-vCPU AMD EPYC virtual machine,
-#: measured 2026-11-27 (Numba 0.68.1). Where a process that runs at the same time compiled a
-#: kernel first, the part loads it instead: in :data:`PARALLEL_GROUPS` ``models`` takes 0.5 s,
-#: as ``sysid`` compiles the model kernels it shares.
+#: measured 2026-11-27 (Numba 0.68.1). A kernel already in the cache is loaded, not compiled:
+#: in :data:`PARALLEL_GROUPS` ``models`` took 0.5 s (the parts before it or ``sysid`` beside it
+#: had compiled what it needs), so the estimate of those groups is high by about 20 s.
 COLD_COMPILE_S: dict[str, float] = {
     "heading": 35.0,
     "speed": 16.5,
