@@ -1245,12 +1245,9 @@ class VMMFamily(ModelFamily):
     def candidates(self, current: Candidate) -> list[str]:
         """The catalogue less the effects whose terms the term set holds already (its
         straight-running side force and moment, :data:`ASYMMETRY_TERMS`, are the
-        ``asymmetry`` effect's) and, on ``vmm:auto``'s base, those its choice of structure
-        scored already (``extra["scored_as_structure"]``: ``<set>+turn_asymmetry`` is the same
-        model as the base with the effect ``turn_asymmetry``, and it lost)."""
+        ``asymmetry`` effect's)."""
         terms = set(term_set_terms(current.fitted.term_set or self.term_set))
         skip = {e for e, t in _EFFECT_TERMS.items() if e != "asymmetry" and set(t) <= terms}
-        skip |= set(current.extra.get("scored_as_structure", ()))
         return [e for e in super().candidates(current) if e not in skip]
 
     def prepare(self, record: Any, holdout: float, window_s: float | None) -> _Context:
@@ -1757,6 +1754,13 @@ class VMMAutoFamily(VMMFamily):
     def __init__(self) -> None:
         super().__init__("martin_simple")
         self.name = "vmm:auto"
+
+    def candidates(self, current: Candidate) -> list[str]:
+        """:meth:`VMMFamily.candidates` less, on the base, the effects its choice of structure
+        scored already (``extra["scored_as_structure"]``: ``<set>+turn_asymmetry`` is the same
+        model as the base with the effect ``turn_asymmetry``, and it lost)."""
+        scored = set(current.extra.get("scored_as_structure", ()))
+        return [e for e in super().candidates(current) if e not in scored]
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         def base(term_set: str) -> Candidate | Exception:
