@@ -20,9 +20,9 @@ of 10/10 and 20/20 zigzags and 35 deg turns to both sides, noise on every channe
 main particulars as plain meta keys; the effect's size and direction, the headings, speeds and
 lengths come from the seed. :func:`shipgym.sysid.identify` fits them with ``--model`` (default
 ``vmm:auto``, or ``vmm:martin_simple`` where ``vmm:auto`` is not registered) and its default
-hold-out (two runs, each a manoeuvre a training run also makes: the starboard 20/20 zigzag and
-the port turn). Only the records are read, never their
-``meta["truth"]``.
+hold-out (two runs, each a manoeuvre a training run also makes: the starboard 20/20 and the
+port 10/10 zigzag; a turn to each side stays in the fits). Only the records are read, never
+their ``meta["truth"]``.
 
 Printed and written per effect: how often the undeclared effect is the first one named, how
 often the held-out heading RMS is at least halved (``heldout["error_before"]`` against

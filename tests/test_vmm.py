@@ -470,35 +470,52 @@ def _rudder(kind: str, amplitude_deg: float, side: float = 1.0) -> np.ndarray:
 def test_manoeuvre_kinds() -> None:
     from shipgym.sysid.families.base import manoeuvre_kind
 
-    assert manoeuvre_kind(_rudder("zigzag", 20.0)) == (True, 4)
-    assert manoeuvre_kind(_rudder("zigzag", 10.0, -1.0)) == (True, 2)
-    assert manoeuvre_kind(_rudder("turn", 35.0, -1.0)) == (False, 7)
+    assert manoeuvre_kind(_rudder("zigzag", 20.0)) == (True, 4, 0)
+    # a zigzag to either side first is one kind; a turn to port and to starboard are two
+    assert manoeuvre_kind(_rudder("zigzag", 10.0, -1.0)) == (True, 2, 0)
+    assert manoeuvre_kind(_rudder("zigzag", 10.0)) == (True, 2, 0)
+    assert manoeuvre_kind(_rudder("turn", 35.0, -1.0)) == (False, 7, -1)
+    assert manoeuvre_kind(_rudder("turn", 35.0)) == (False, 7, 1)
     spiked = _rudder("zigzag", 10.0)
     spiked[50] = math.radians(40.0)  # one glitch does not make a 40 deg manoeuvre
-    assert manoeuvre_kind(spiked) == (True, 2)
+    assert manoeuvre_kind(spiked) == (True, 2, 0)
+    assert manoeuvre_kind(np.full(5, np.nan)) == (False, 0, 0)
 
 
 def test_held_out_runs_are_manoeuvres_a_training_run_also_makes() -> None:
     """Several runs: the held-out ones each have a training run of their kind, whatever the
-    order of the files; the count is that of every ``1/holdout``-th run; when every manoeuvre
-    is made once, the score is an extrapolation and a note says so."""
+    order of the files (so a turn to each side stays in the fits); the count is that of every
+    ``1/holdout``-th run; when every manoeuvre is made once, the score is an extrapolation and
+    a note says so."""
     from shipgym.sysid.families.base import holdout_runs, manoeuvre_kind
 
     # the MMG generator's order: 10/10, 35 turn, 20/20 to starboard, then to port
     mmg = [_rudder(k, a, s) for s in (1.0, -1.0)
            for k, a in (("zigzag", 10.0), ("turn", 35.0), ("zigzag", 20.0))]  # fmt: skip
     held, notes = holdout_runs(mmg, 0.3)
-    assert held == [2, 4] and not notes  # not both 20/20 zigzags: one stays in training
+    # a 20/20 and a 10/10 zigzag: one of each amplitude and both turns stay in training
+    assert held == [2, 3] and not notes
     # the MARIN files in name order (tc -35, tc 35, zz -10, zz -20, zz 10, zz 20): as before
     marin = [_rudder("turn", 35.0, -1.0), _rudder("turn", 35.0), _rudder("zigzag", 10.0, -1.0),
              _rudder("zigzag", 20.0, -1.0), _rudder("zigzag", 10.0), _rudder("zigzag", 20.0)]
     assert holdout_runs(marin, 0.3) == ([2, 5], [])
     for runs in (mmg, marin, mmg[::-1], marin[1:]):
         for frac in (0.2, 0.3, 0.5):
-            held, _ = holdout_runs(runs, frac)
+            held, notes = holdout_runs(runs, frac)
             assert len(held) == max(1, len(runs) // max(2, round(1.0 / frac)))
             train = [manoeuvre_kind(runs[i]) for i in range(len(runs)) if i not in held]
-            assert all(manoeuvre_kind(runs[i]) in train for i in held)
+            alone = [i for i in held if manoeuvre_kind(runs[i]) not in train]
+            assert len(alone) == len(notes)  # a run held out without a partner is named
+            turn_kinds = {k for k in map(manoeuvre_kind, runs) if not k[0]}
+            if not notes:  # (half of six runs cannot all have a partner: a turn goes)
+                assert turn_kinds <= set(train)  # a turn to each side is fitted
+    assert len(holdout_runs(mmg, 0.5)[1]) == 1
+    turns = [_rudder("turn", 35.0), _rudder("turn", 35.0, -1.0), _rudder("zigzag", 10.0)]
+    held, notes = holdout_runs(turns, 0.5, ["t+", "t-", "z10"])
+    assert held == [1] and notes == [
+        "held-out run t- (turn, rudder about -35 deg) is the only one of its kind: its score "
+        "is an extrapolation"
+    ]
     single = [_rudder("zigzag", a) for a in (5.0, 10.0, 15.0, 20.0)]
     held, notes = holdout_runs(single, 0.3, ["z5", "z10", "z15", "z20"])
     assert held == [2] and notes == [

@@ -441,17 +441,21 @@ MANOEUVRE_STEP_DEG = 5.0
 and a 20/10 zigzag are alike; a 10/10 and a 20/20 zigzag are not)."""
 
 
-def manoeuvre_kind(delta: np.ndarray) -> tuple[bool, int]:
+def manoeuvre_kind(delta: np.ndarray) -> tuple[bool, int, int]:
     """The kind of manoeuvre a recorded rudder makes: whether it reverses (a zigzag or a random
-    manoeuvre, against a turn or a pull-out) and its amplitude in steps of
-    :data:`MANOEUVRE_STEP_DEG` (the 98th percentile of ``|delta|``, robust to a spike)."""
+    manoeuvre, against a turn or a pull-out), its amplitude in steps of
+    :data:`MANOEUVRE_STEP_DEG` (the 98th percentile of ``|delta|``, robust to a spike) and, for
+    a run that does not reverse, the side of its rudder (the sign of its median; 0 for one that
+    reverses). A turn to port and a turn to starboard are two kinds: a ship's port/starboard
+    difference (a single-screw hull's, a rudder zero error's) shows only between the two."""
     d = np.asarray(delta, dtype=np.float64)
     d = d[np.isfinite(d)]
     if d.size == 0:
-        return False, 0
+        return False, 0, 0
     amplitude = float(np.percentile(np.abs(d), 98.0))
     reverses = bool(d.max() > 0.3 * amplitude and d.min() < -0.3 * amplitude)
-    return reverses, round(math.degrees(amplitude) / MANOEUVRE_STEP_DEG)
+    side = 0 if reverses else int(np.sign(np.median(d)))
+    return reverses, round(math.degrees(amplitude) / MANOEUVRE_STEP_DEG), side
 
 
 def holdout_runs(
@@ -461,7 +465,8 @@ def holdout_runs(
     together: ``n // round(1 / holdout)`` of them (at least one), each a manoeuvre of a kind
     (:func:`manoeuvre_kind`) that a training run also makes, so that the score measures how
     the model predicts manoeuvres like those it was fitted on, not an extrapolation to a rudder
-    amplitude it never saw (whatever order the files come in).
+    amplitude or a turning side it never saw (whatever order the files come in: of a turn to
+    each side, both stay in the fits).
 
     The runs are taken in this order of preference: every ``round(1 / holdout)``-th run, then
     the others from the last; a run is held out when another run of its kind stays in the
@@ -503,11 +508,15 @@ def holdout_runs(
             break
         if i not in held:
             held.append(i)
-            kind = "zigzag" if kinds[i][0] else "turn"
-            amplitude = kinds[i][1] * MANOEUVRE_STEP_DEG
+            reverses, steps, side = kinds[i]
+            amplitude = steps * MANOEUVRE_STEP_DEG
+            if reverses:
+                kind = f"zigzag, rudder about {amplitude:g}"
+            else:
+                kind = f"turn, rudder about {side * amplitude:+g}"
             notes.append(
-                f"held-out run {names[i] if names else i} ({kind}, rudder about {amplitude:g} "
-                "deg) is the only one of its kind: its score is an extrapolation"
+                f"held-out run {names[i] if names else i} ({kind} deg) is the only one of its "
+                "kind: its score is an extrapolation"
             )
     return sorted(held), notes
 
