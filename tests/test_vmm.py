@@ -428,6 +428,21 @@ def test_a_model_that_diverges_on_its_own_training_runs_is_no_candidate() -> Non
     assert math.isinf(cand.J) and cand.extra["diverges_on"] == "its training runs"
 
 
+def test_a_current_is_never_screened_out_by_the_regression(monkeypatch) -> None:
+    """A current moves the ship over ground; the regression of the forces sees it only through
+    the speeds through the water (on ShipMMG's records its equation error hardly drops), so it
+    is always refined and judged by simulation, where other hull effects may be screened."""
+    from shipgym.sysid.families import vmm
+    from shipgym.sysid.families.base import FAMILIES
+
+    family = FAMILIES["vmm:linear"]
+    ctx = family.prepare(generate_vmm_runs("current", n_runs=3, seed=1, dt=0.5), 0.3, "auto")
+    base = family.fit_base(ctx, lambda _msg: None)
+    monkeypatch.setattr(vmm, "SCREEN_MIN_DROP", math.inf)  # every drop is too small
+    assert family.try_effect(ctx, base, "current").fitted.refined
+    assert not family.try_effect(ctx, base, "rudder_slipstream").fitted.refined
+
+
 def test_a_replay_of_some_windows_is_the_full_replay_on_them() -> None:
     """A fit on some runs replays only their windows: each window is simulated from its own
     start, so its samples are those of the full replay, bit for bit; the others are NaN."""

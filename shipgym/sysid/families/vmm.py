@@ -1363,7 +1363,9 @@ class VMMFamily(ModelFamily):
         An actuator cause (rudder offset, steering-gear lag, input delay) changes the rudder
         every term sees: its parameter starts where the regression on the rudder so felt
         explains the training runs' forces best (:meth:`_profile_actuator`), and the refinement
-        estimates it with the coefficients; it is never screened out."""
+        estimates it with the coefficients; it is never screened out. Nor is a current: it moves
+        the ship over ground, which the regression of the forces sees only through the speeds
+        through the water (on ShipMMG-made records its equation error hardly drops)."""
         if name == "wind" and not all(r.has_wind for r in ctx.runs):
             raise ValueError("the records have no wind channels")
         effects = (*current.effects, name)
@@ -1373,7 +1375,7 @@ class VMMFamily(ModelFamily):
             return _flag_bound(self._candidate(ctx, effects, regressed), name, ctx.rp_fit)
         fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
         drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
-        if not self.refine or drop < SCREEN_MIN_DROP:
+        if not self.refine or (drop < SCREEN_MIN_DROP and name != "current"):
             cand = self._score(ctx, fit)
             cand.extra["screen_equation_error_drop"] = drop
             return cand
