@@ -297,6 +297,13 @@ def main(argv: list[str] | None = None) -> int:
               if simman_path.exists() else {})  # fmt: skip
     hsva = _records(root, "hsva_kvlcc2", "*.dat")
     marin = _records(root, "marin_kvlcc2", "*.dat")
+    for folder, recs in (("hsva_kvlcc2", hsva), ("marin_kvlcc2", marin)):
+        if not recs:
+            dataset = folder.replace("_", "-")
+            ap.error(
+                f"no records in {root / folder}: fetch them (shipgym data fetch {dataset}) "
+                "or pass --root, the folder that holds hsva_kvlcc2/ and marin_kvlcc2/"
+            )
     n_h = len(hsva)
 
     t0 = time.perf_counter()
