@@ -465,8 +465,8 @@ def holdout_runs(
     together: ``n // round(1 / holdout)`` of them (at least one), each a manoeuvre of a kind
     (:func:`manoeuvre_kind`) that a training run also makes, so that the score measures how
     the model predicts manoeuvres like those it was fitted on, not an extrapolation to a rudder
-    amplitude or a turning side it never saw (whatever order the files come in: of a turn to
-    each side, both stay in the fits).
+    amplitude or a turning side it never saw (whatever order the files come in: a turn is held
+    out only if another turn to its side stays in the fits).
 
     The runs are taken in this order of preference: every ``round(1 / holdout)``-th run, then
     the others from the last; a run is held out when another run of its kind stays in the
