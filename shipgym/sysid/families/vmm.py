@@ -123,7 +123,12 @@ from a poor start (scoring uses the longer ``window_s``)."""
 
 SCREEN_MIN_DROP = 0.01
 """Smallest relative drop of the equation error (mean ``1 - R^2`` of X, Y, N on the training
-runs) for which a candidate effect is refined by output error and judged by simulation."""
+runs) for which a candidate effect is refined by output error and judged by simulation (the
+actuator causes and ``_UNSCREENED`` are refined whatever the drop)."""
+
+#: Effects the regression cannot screen: a current moves the ship over ground, which the
+#: regression of the forces sees only through the speeds through the water.
+_UNSCREENED = ("current",)
 
 START_PRIOR = 0.005
 """Prior standard deviation of the estimated initial sway (``START_PRIOR U``) and yaw rate
@@ -1375,7 +1380,7 @@ class VMMFamily(ModelFamily):
             return _flag_bound(self._candidate(ctx, effects, regressed), name, ctx.rp_fit)
         fit = self._fit(ctx, effects, ctx.train, False, current.fitted.actuators)
         drop = 1.0 - _equation_error(fit) / max(_equation_error(current.fitted), 1e-300)
-        if not self.refine or (drop < SCREEN_MIN_DROP and name != "current"):
+        if not self.refine or (drop < SCREEN_MIN_DROP and name not in _UNSCREENED):
             cand = self._score(ctx, fit)
             cand.extra["screen_equation_error_drop"] = drop
             return cand
