@@ -1734,29 +1734,40 @@ def describe_selection(selection: Mapping[str, Any]) -> str:
 class VMMAutoFamily(VMMFamily):
     """``vmm:auto``: the VMM whose structure predicts the held-out runs best.
 
-    Every term set of :data:`~shipgym.models.vmm.TERM_SETS` is fitted as a base model on the
-    training runs (regression and refinement, two at a time) and scored on the held-out runs,
-    the same cross-validation across runs that then judges the effects; the best of them
-    (:attr:`ASYMMETRIC_TRIES`) is fitted again with the single-screw port/starboard difference
-    as part of the structure (:data:`STRUCTURE_EFFECTS`, ``"<set>+turn_asymmetry"``), a forward
-    step as in stepwise regression. The structure with the lowest held-out error (the geometric
-    mean of the ``psi, r, u, v`` RMS) wins, and the loop goes on with it (the effects of
-    :data:`STRUCTURE_EFFECTS` it scored as structure are not tried again in its first round): a
-    symmetric ship keeps a symmetric structure, an asymmetric one does not leave its asymmetry
-    for the loop to mistake for a rudder zero error or a wind. The scores of every structure
-    are said and kept in the diagnostics (``term_set_selection``).
+    The structures are every term set of :data:`~shipgym.models.vmm.TERM_SETS`, each alone and
+    with the single-screw port/starboard difference as part of it (:data:`STRUCTURE_EFFECTS`,
+    ``"<set>+turn_asymmetry"``). Each is chosen by the same cross-validation across runs that
+    then judges the effects, in two stages:
 
-    Every structure is refined in full before it is ranked: ranked after 6 of the 20 cost
-    evaluations instead (half the cost), the 60-term Abkowitz set, slower to converge, lost
-    to smaller sets that predict worse once all are converged (19 of the 36 MMG-made record
-    sets chose another structure, their median held-out heading error 0.98 -> 1.24 deg);
-    after 10 it still did, after 40 the ranking is that after 20, every score within 5 %.
+    1. **screen**: each structure's regression on the training runs predicts the held-out runs
+       (:func:`predict`, no refinement: a tenth of a refinement's cost);
+    2. **judge**: the :attr:`REFINED_STRUCTURES` best of the screen are refined by output
+       error and scored (two at a time); the lowest held-out error (the geometric mean of the
+       ``psi, r, u, v`` RMS) wins.
+
+    The loop goes on with the winner (an effect of :data:`STRUCTURE_EFFECTS` whose structure
+    was judged is not tried again in its first round): a symmetric ship keeps a symmetric
+    structure, an asymmetric one does not leave its asymmetry for the loop to mistake for a
+    rudder zero error or a wind. Both stages' scores are said and kept in the diagnostics
+    (``term_set_selection``: ``heldout_error`` of the judged structures, ``screened`` of all).
+
+    Why every structure, and why a screen: the refined ranking of the symmetric sets says
+    little about which set takes the asymmetry best. With only the best symmetric set tried
+    with it, 20 of the 36 MMG-made record sets ended with another structure than with every
+    structure refined, whose base model's held-out heading error was 2.2 times as large
+    (median; 0.9 to 10 times); on the clean sets 1.45 deg (median) and 6.2 deg at worst, against
+    0.62 and 0.75 deg. Refining all twelve cost twice the time (the 13 HSVA runs: 54 s
+    against 28 s); the screen and four refinements chose what refining all chose in 32 of the
+    36 sets, in 24 s on the HSVA runs (there it keeps ``martin_simple``: the refined
+    ``abkowitz+turn_asymmetry`` predicts 8 % better, fifth in the screen, and its refit on
+    every run diverges).
+    Every judged structure is refined in full before it is ranked: ranked after 6 of the 20
+    cost evaluations instead (half the cost), the 60-term Abkowitz set, slower to converge,
+    lost to smaller sets that predict worse once all are converged.
     """
 
-    #: How many of the best symmetric term sets are tried with :data:`STRUCTURE_EFFECTS`. One:
-    #: on the 13 HSVA runs the second is the Abkowitz set (12 s more, and chosen with 60 terms
-    #: its refit on every run diverges).
-    ASYMMETRIC_TRIES = 1
+    #: How many of the screen's best structures are refined and judged.
+    REFINED_STRUCTURES = 4
 
     def __init__(self) -> None:
         super().__init__("martin_simple")
@@ -1764,31 +1775,43 @@ class VMMAutoFamily(VMMFamily):
 
     def candidates(self, current: Candidate) -> list[str]:
         """:meth:`VMMFamily.candidates` less, on the base, the effects its choice of structure
-        scored already (``extra["scored_as_structure"]``: ``<set>+turn_asymmetry`` is the same
+        judged already (``extra["scored_as_structure"]``: ``<set>+turn_asymmetry`` is the same
         model as the base with the effect ``turn_asymmetry``, and it lost)."""
         scored = set(current.extra.get("scored_as_structure", ()))
         return [e for e in super().candidates(current) if e not in scored]
 
+    def _screen(self, ctx: _Context, structure: str) -> float:
+        """Held-out error of ``structure``'s regression on the training runs (``inf`` when it
+        cannot be fitted or diverges on a held-out run)."""
+        try:
+            fit = self._fit(replace(ctx, term_set=structure), (), ctx.train, False)
+        except (ValueError, np.linalg.LinAlgError):
+            return math.inf
+        sim = predict(fit, ctx.rp, ctx.held)
+        mask = ctx.rp.run_mask(ctx.held)
+        if not np.all(np.isfinite(sim[mask])):
+            return math.inf
+        rms = np.sqrt(np.mean(_channel_errors(sim[mask], ctx.rp.measured[mask]) ** 2, axis=1))
+        return math.exp(float(np.mean(np.log(np.maximum(rms, 1e-300)))))
+
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
-        def base(term_set: str) -> Candidate | Exception:
+        def judge(structure: str) -> Candidate | Exception:
             try:
-                return self._candidate(replace(ctx, term_set=term_set), ())
+                return self._candidate(replace(ctx, term_set=structure), ())
             except (ValueError, np.linalg.LinAlgError) as exc:
                 return exc
 
-        def fit(names: list[str]) -> dict[str, Candidate | Exception]:
-            with ThreadPoolExecutor(max_workers=2) as pool:
-                return dict(zip(names, pool.map(base, names), strict=True))
-
-        def ranked_finite(outcomes: Mapping[str, Candidate | Exception]) -> list[str]:
-            """The fitted structures with a finite held-out error, best first."""
-            fitted = {n: c for n, c in outcomes.items() if isinstance(c, Candidate)}
-            finite = [n for n in fitted if math.isfinite(fitted[n].heldout_error)]
-            return sorted(finite, key=lambda n: fitted[n].heldout_error)
-
-        outcomes = fit(list(TERM_SETS))
-        best = ranked_finite(outcomes)[: self.ASYMMETRIC_TRIES]
-        outcomes |= fit([f"{n}+{e}" for n in best for e in STRUCTURE_EFFECTS])
+        structures = list(TERM_SETS) + [f"{n}+{e}" for n in TERM_SETS for e in STRUCTURE_EFFECTS]
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            screened = dict(zip(structures, pool.map(lambda n: self._screen(ctx, n), structures),
+                                strict=True))  # fmt: skip
+            order = sorted((n for n in structures if math.isfinite(screened[n])),
+                           key=screened.__getitem__)  # fmt: skip
+            best = order[: self.REFINED_STRUCTURES] or structures[: self.REFINED_STRUCTURES]
+            outcomes = dict(zip(best, pool.map(judge, best), strict=True))
+        ranking = sorted(structures, key=screened.__getitem__)
+        say("  screened by their regressions: "
+            + ", ".join(f"{n} {screened[n]:.4g}" for n in ranking))  # fmt: skip
         fitted = {n: c for n, c in outcomes.items() if isinstance(c, Candidate)}
         ranked = sorted(fitted, key=lambda n: fitted[n].heldout_error)
         if not ranked or not math.isfinite(fitted[ranked[0]].heldout_error):
@@ -1800,7 +1823,8 @@ class VMMAutoFamily(VMMFamily):
         scores = {n: fitted[n].heldout_error for n in ranked}
         runner_up = next((n for n in ranked[1:] if math.isfinite(scores[n])), None)
         ctx.term_set = ranked[0]
-        ctx.selection = {"chosen": ranked[0], "heldout_error": scores, "runner_up": runner_up}
+        ctx.selection = {"chosen": ranked[0], "heldout_error": scores, "runner_up": runner_up,
+                         "screened": screened}  # fmt: skip
         say(f"term set {describe_selection(ctx.selection)}")
         chosen = fitted[ranked[0]]
         chosen.extra["scored_as_structure"] = tuple(
