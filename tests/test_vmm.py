@@ -415,6 +415,25 @@ def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     assert {"asymmetry", "rudder_offset", "current"} <= set(result.rounds[0])
 
 
+def test_when_every_regression_runs_away_vmm_auto_still_refines_some_structures(
+    monkeypatch,
+) -> None:
+    """A regression that runs away on the held-out runs screens ``inf``, but its refinement may
+    not: when every structure's does, the first :attr:`REFINED_STRUCTURES` are refined and
+    judged all the same, and the best of them is chosen."""
+    from shipgym.sysid.families.vmm import VMMAutoFamily
+
+    monkeypatch.setattr(VMMAutoFamily, "_screen", lambda self, ctx, structure: math.inf)
+    runs = generate_vmm_runs(None, n_runs=3, seed=2, dt=0.5)
+    result = identify(runs, "vmm:auto", max_effects=0)
+    sel = result.diagnostics["term_set_selection"]
+    assert all(math.isinf(v) for v in sel["screened"].values())
+    assert list(sel["heldout_error"]) == sorted(
+        list(TERM_SETS)[: VMMAutoFamily.REFINED_STRUCTURES], key=sel["heldout_error"].get
+    )
+    assert math.isfinite(sel["heldout_error"][sel["chosen"]])
+
+
 def test_a_model_that_diverges_on_its_own_training_runs_is_no_candidate() -> None:
     """A candidate must replay the runs it was fitted on, not only the held-out ones: a course
     that runs away on a training run scores ``inf`` and says why (the held-out runs are left
