@@ -92,6 +92,33 @@ def test_straight_running_at_the_approach_thrust_holds_the_speed() -> None:
     assert d[0] == pytest.approx(ship.approach_speed * math.cos(0.3), rel=1e-12)
 
 
+def test_a_straight_course_needs_minus_the_zero_error_a_side_force_stands_for() -> None:
+    """A mirror-symmetric ship holds a straight course with the rudder amidships and no drift.
+    One whose straight-running side force and moment are those of a rudder zero error
+    ``delta0`` (``Y_u = Y_d delta0, N_u = N_d delta0``, ``u' = 1``) needs ``-delta0`` and no
+    drift; the ``asymmetry`` effect reports ``delta0`` as its equivalent zero error. A moment
+    the rudder cannot hold is refused."""
+    from types import SimpleNamespace
+
+    from shipgym.sysid.families.base import FAMILIES
+
+    ship = _ship()
+    delta, v, thrust = ship.straight_course()
+    assert delta == pytest.approx(0.0, abs=1e-10) and v == pytest.approx(0.0, abs=1e-10)
+    assert thrust == pytest.approx(ship.approach_thrust(), rel=1e-9)
+    d0 = math.radians(1.5)
+    c = ship.coefficients
+    asymmetric = {"Y_u": c["Y_d"] * d0, "N_u": c["N_d"] * d0}
+    offset = _ship(**asymmetric)
+    delta, v, _ = offset.straight_course()
+    assert delta == pytest.approx(-d0, rel=1e-6) and v == pytest.approx(0.0, abs=1e-9)
+    fitted = SimpleNamespace(values=asymmetric, params=offset)
+    reported = FAMILIES["vmm:linear"].effect_parameters(fitted, "asymmetry")
+    assert reported["rudder_offset_deg"] == pytest.approx(1.5, rel=1e-6)
+    with pytest.raises(ValueError, match="no straight course"):
+        _ship(Y_u=c["Y_d"], N_u=c["N_d"]).straight_course()  # a zero error of 57 deg
+
+
 def test_sway_yaw_accelerations_solve_the_seed_system() -> None:
     """The seed's eq_system: [m - Yv', m xG - Yr'; m xG - Nv', Iz - Nr'] [v', r'] =
     [Y_D - m r u; N_D - m xG r u] with C_A written out, here with the linear terms."""

@@ -677,6 +677,52 @@ class VMMParams:
         return float(brentq(surge, lo, hi, xtol=1e-9 * q))
 
 
+    def straight_course(self) -> tuple[float, float, float]:
+        """The rudder, sway and thrust that hold a straight course at the approach speed.
+
+        The steady state with no yaw rate (:func:`vmm_row`: ``du = dv = dr = 0`` at ``r = 0``,
+        ``u`` the approach speed), solved for the rudder order, the sway velocity and the
+        thrust input from ``(0, 0,`` :meth:`approach_thrust` ``)``. A mirror-symmetric ship
+        holds its course with the rudder amidships and no drift; a straight-running side force
+        and yaw moment (the terms of ``Y_0, N_0``, ``Y_T, N_T`` ...) need a rudder, which a
+        rudder zero error of minus that angle would need too.
+
+        Returns
+        -------
+        delta, v, thrust : float
+            Rudder order [rad], sway velocity [m/s] and thrust input.
+
+        Raises
+        ------
+        ValueError
+            When no steady straight course is found with the rudder within its limit.
+        """
+        from scipy.optimize import root
+
+        p = pack_vmm(replace(self, direct_rudder=True))
+        q = 0.5 * self.rho * self.length**2 * self.approach_speed**2
+        x = np.zeros(7)
+        x[IU] = self.approach_speed
+        out = np.empty(7)
+        c = np.zeros(2)
+
+        def steady(z: np.ndarray) -> np.ndarray:
+            x[IV] = z[1] * self.approach_speed
+            vmm_row(x, np.array([z[0], z[2] * q, 0.0, 0.0]), p, c, out)
+            return np.array([out[IU], out[IV], out[IR] * self.length]) / self.approach_speed
+
+        sol = root(steady, np.array([0.0, 0.0, self.approach_thrust() / q]), method="hybr")
+        delta, v_prime, thrust = (float(z) for z in sol.x)
+        where = f"no straight course at {self.approach_speed:g} m/s"
+        if not sol.success:
+            raise ValueError(f"{where}: the steady state was not found ({sol.message})")
+        if abs(delta) > self.max_rudder:
+            raise ValueError(
+                f"{where} with the rudder within its limit: it would take "
+                f"{math.degrees(delta):.3g} deg, the limit is {math.degrees(self.max_rudder):g} deg"
+            )
+        return delta, v_prime * self.approach_speed, thrust * q
+
 _ADDED = ("X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot")
 _REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
                   "yaw_inertia", "added", "approach_speed")  # fmt: skip

@@ -149,7 +149,8 @@ VMM_EFFECTS: dict[str, Effect] = {
         {},
         "the single propeller's side force (the seed's Y0, N0): a force that does not grow "
         "with the rudder's inflow as a rudder zero error does; reported also as the "
-        "equivalent rudder offset -N_0 / N_d",
+        "equivalent rudder zero error, minus the rudder that holds a straight course "
+        "(VMMParams.straight_course)",
     ),
     **causes("rudder_offset", "rudder_lag", "input_delay", "current"),
     "rudder_slipstream": Effect(
@@ -1423,9 +1424,10 @@ class VMMFamily(ModelFamily):
         vals = fitted.values
         if name == "asymmetry":
             out = {k: v for k, v in vals.items() if k in ASYMMETRY_TERMS}
-            if fitted.params.coefficients.get("N_d"):  # N_0 + N_u (u' ~ 1) in straight running
-                n_0 = sum(v for k, v in out.items() if k in ("N_0", "N_u", "N_0u", "N_0uu"))
-                out["rudder_offset_deg"] = -math.degrees(n_0 / fitted.params.coefficients["N_d"])
+            try:  # the zero error that would need the same rudder to hold a straight course
+                out["rudder_offset_deg"] = -math.degrees(fitted.params.straight_course()[0])
+            except ValueError:
+                pass
             return out
         out = {k: vals.get(k, 0.0) for k in self.catalogue[name].parameters}
         if name == "current":
