@@ -676,7 +676,6 @@ class VMMParams:
             raise ValueError("no thrust holds the approach speed with these coefficients")
         return float(brentq(surge, lo, hi, xtol=1e-9 * q))
 
-
     def straight_course(self) -> tuple[float, float, float]:
         """The rudder, sway and thrust that hold a straight course at the approach speed.
 
@@ -722,6 +721,7 @@ class VMMParams:
                 f"{math.degrees(delta):.3g} deg, the limit is {math.degrees(self.max_rudder):g} deg"
             )
         return delta, v_prime * self.approach_speed, thrust * q
+
 
 _ADDED = ("X_udot", "Y_vdot", "Y_rdot", "N_vdot", "N_rdot")
 _REQUIRED_KEYS = ("coefficients", "length", "breadth", "draught", "mass", "x_g",
