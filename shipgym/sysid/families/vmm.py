@@ -1189,6 +1189,16 @@ class _Context:
     holdout_notes: list[str] = field(default_factory=list)  # held-out runs without a partner
 
 
+def _prediction_errors(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray | None:
+    """Errors of :func:`predict` on the scored samples of ``runs``, a row per channel of
+    ``psi, r, u, v``; None when the prediction diverges."""
+    sim = predict(fit, rp, runs)
+    mask = rp.run_mask(runs)
+    if not np.all(np.isfinite(sim[mask])):
+        return None
+    return _channel_errors(sim[mask], rp.measured[mask])
+
+
 def _geometric_mean(rms: Sequence[float] | np.ndarray) -> float:
     """The geometric mean of the channels' RMS errors: the held-out error a candidate and a
     structure are ranked by."""
@@ -1303,16 +1313,14 @@ class VMMFamily(ModelFamily):
         model of the ship (seen on ShipMMG-made runs with a current: a term set that predicted
         the held-out runs diverged on its own training turn, and the report could not be
         made)."""
-        sim = predict(fit, ctx.rp, ctx.held)
-        mask = ctx.rp.run_mask(ctx.held)
-        n = int(mask.sum())
+        e = _prediction_errors(fit, ctx.rp, ctx.held)
         diverges = Candidate(fit.effects, fit, math.inf, math.inf)
-        if not np.all(np.isfinite(sim[mask])):
+        if e is None:
             return diverges
-        if not np.all(np.isfinite(predict(fit, ctx.rp, ctx.train)[ctx.rp.run_mask(ctx.train)])):
+        if _prediction_errors(fit, ctx.rp, ctx.train) is None:
             diverges.extra["diverges_on"] = "its training runs"
             return diverges
-        e = _channel_errors(sim[mask], ctx.rp.measured[mask])
+        n = e.shape[1]
         rss = {ch: float(row @ row) for ch, row in zip(_CHANNELS, e, strict=True)}
         rms = {k: math.sqrt(v / n) for k, v in rss.items()}
         err = _geometric_mean(list(rms.values()))
@@ -1796,12 +1804,8 @@ class VMMAutoFamily(VMMFamily):
             fit = self._fit(replace(ctx, term_set=structure), (), ctx.train, False)
         except (ValueError, np.linalg.LinAlgError):
             return math.inf
-        sim = predict(fit, ctx.rp, ctx.held)
-        mask = ctx.rp.run_mask(ctx.held)
-        if not np.all(np.isfinite(sim[mask])):
-            return math.inf
-        rms = np.sqrt(np.mean(_channel_errors(sim[mask], ctx.rp.measured[mask]) ** 2, axis=1))
-        return _geometric_mean(rms)
+        e = _prediction_errors(fit, ctx.rp, ctx.held)
+        return math.inf if e is None else _geometric_mean(np.sqrt(np.mean(e * e, axis=1)))
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
         def judge(structure: str) -> Candidate | Exception:
