@@ -31,7 +31,11 @@ both; for the clean records how often no actuator effect
 (:data:`ACTUATOR_EFFECTS`) is named. The target is at least 5 of 6 seeds for each. Beside them,
 the effect's *footprint* (:func:`footprint`): the held-out heading RMS of the true hull driven
 by the recorded rudder without the effect, the most that naming it can take off a perfect
-model's error (the script reads the truth for it; the identification never does).
+model's error (the script reads the truth for it; the identification never does). For an
+actuator effect and a current, also the same identification of the records with the effect
+taken out (:func:`effect_removed`, from the truth): its base model's held-out heading RMS is
+the most that naming the effect exactly can give the structures the loop chooses from, so the
+error can be halved only where that is at most half the error before (*halving within reach*).
 
 With ``--simulator shipmmg`` the motions come from ShipMMG instead (:func:`shipmmg_runs`; no
 wind: ShipMMG has no wind loads), a cross-check that the counts are not an artefact of
@@ -120,6 +124,45 @@ def footprint(effect: str | None, seed: int, n_runs: int, held: list[str]) -> fl
     return math.sqrt(sq / n) if n else math.nan
 
 
+def felt_rudder(rec: Record) -> np.ndarray:
+    """The rudder the ship of a made record felt: its recorded rudder under the true zero
+    error, gear lag or delay (:func:`~shipgym.sysid.families.base.actual_rudder`, the KVLCC2's
+    gear limits), read from ``meta["truth"]``."""
+    p = MMGParams.kvlcc2()
+    truth = rec.meta["truth"]
+    e = truth["effect_parameters"]
+    return actual_rudder(
+        rec.time, rec.delta, rudder_offset=e.get("delta_0", 0.0), rudder_lag=e.get("T_delta"),
+        input_delay=e.get("tau", 0.0), y0=truth["x0"][_mmg.IDELTA],
+        gear=SteeringGear(max_angle=p.max_rudder, max_rate=p.rudder_rate),
+    )  # fmt: skip
+
+
+REMOVABLE = (*ACTUATOR_EFFECTS, "current")
+"""Effects a record can be read without (:func:`effect_removed`); a wind is a force on the
+hull, which no channel of a record can take back out."""
+
+
+def effect_removed(runs: list[Record]) -> list[Record]:
+    """The runs as they read without their undeclared effect, from their truth: the recorded
+    rudder replaced by the rudder the ship felt (:func:`felt_rudder`, an actuator effect), or
+    the positions and velocities made relative to the water (a current). What a model fitted
+    to these predicts is the most that naming the effect exactly can give its structure."""
+    out = []
+    for rec in runs:
+        truth = rec.meta["truth"]
+        if truth["effect"] in ACTUATOR_EFFECTS:
+            out.append(replace(rec, delta=felt_rudder(rec)))
+            continue
+        v_n, v_e = truth["current"]
+        cp, sp = np.cos(rec.psi), np.sin(rec.psi)
+        u, v = rec.u - v_n * cp - v_e * sp, rec.v + v_n * sp - v_e * cp
+        t = rec.time - rec.time[0]
+        out.append(replace(rec, x=rec.x - v_n * t, y=rec.y - v_e * t, u=u, v=v,
+                           U=np.hypot(u, v)))  # fmt: skip
+    return out
+
+
 SIMULATOR_NAMES = {"shipgym": "shipgym's", "shipmmg": "ShipMMG's"}
 """Who makes the motions of the records (``--simulator``)."""
 
@@ -133,8 +176,7 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
     parameters as in ``scripts/shipmmg_compare.py``; run in its own environment, see the usage).
 
     Each run keeps its recorded rudder, rpm, start and length. ShipMMG is driven by the rudder the
-    ship feels (:func:`~shipgym.sysid.families.base.actual_rudder` of the recorded one under the
-    true zero error, gear lag or delay); a current is added to ShipMMG's motion through the
+    ship feels (:func:`felt_rudder`); a current is added to ShipMMG's motion through the
     water (positions and body velocities over ground). Noise of :data:`MMG_NOISE` on every
     channel, from its own seeded stream. Raises ``ImportError`` without ShipMMG.
     """
@@ -146,13 +188,8 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
     out = []
     for rec in generate_mmg_runs(effect, seed=seed, noise=False, n_runs=n_runs):
         truth = rec.meta["truth"]
-        e = truth["effect_parameters"]
         t = rec.time
-        felt = actual_rudder(
-            t, rec.delta, rudder_offset=e.get("delta_0", 0.0), rudder_lag=e.get("T_delta"),
-            input_delay=e.get("tau", 0.0), y0=truth["x0"][_mmg.IDELTA],
-            gear=SteeringGear(max_angle=p.max_rudder, max_rate=p.rudder_rate),
-        )  # fmt: skip
+        felt = felt_rudder(rec)
         v_n, v_e = truth["current"]
         psi0 = float(rec.psi[0])
         cs, sn = math.cos(psi0), math.sin(psi0)
@@ -212,6 +249,17 @@ def _case(task: tuple[str | None, int, str, int, str]) -> dict[str, Any]:
         "effect_parameters": {e["name"]: e["parameters"] for e in res.effects},
         "runtime_s": time.perf_counter() - t0,
     }
+    if effect in REMOVABLE:  # the same structures' best with the effect named exactly
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                bound = identify(effect_removed(runs), model, max_effects=0)
+            removed = _psi(bound.heldout.get("error_before"))
+        except (ValueError, RuntimeError, np.linalg.LinAlgError):
+            removed = math.nan
+        row["removed_psi_deg"] = removed
+        row["halving_within_reach"] = bool(math.isfinite(removed) and not removed > 0.5 * before)
+        row["runtime_s"] = time.perf_counter() - t0
     if effect is not None:
         row["named_first"] = row["first"] == effect
         row["passed"] = row["named_first"] and row["halved"]
@@ -242,6 +290,9 @@ def summarise(rows: list[dict[str, Any]], effects: list[str]) -> dict[str, dict[
             "median_footprint_deg": _median([r["footprint_psi_deg"] for r in ok]),
             "asymmetric_structure": sum("+" in (r.get("structure") or "") for r in ok),
         }
+        if effect in REMOVABLE:
+            entry["median_removed_deg"] = _median([r["removed_psi_deg"] for r in ok])
+            entry["halving_within_reach"] = sum(r["halving_within_reach"] for r in ok)
         if effect == CLEAN:
             entry["no_actuator_effect"] = entry["passed"]
             entry["no_effect"] = sum(not r["named"] for r in ok)
@@ -276,8 +327,9 @@ def render(doc: dict[str, Any]) -> str:
         "",
         "| records | named first | held-out heading RMS halved | both | median held-out "
         "heading RMS before → after [deg] | the true hull ignoring the effect [deg] | "
+        "the effect taken out of the records [deg] (halving within reach) | "
         "effects named (per seed) |",
-        "|---|---:|---:|---:|---:|---:|---|",
+        "|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for effect, s in doc["summary"].items():
         named = "; ".join(
@@ -290,10 +342,15 @@ def render(doc: dict[str, Any]) -> str:
             else f"{s['named_first']}/{n}"
         )
         both = "" if effect == CLEAN else f"{s['passed']}/{n}"
+        reach = (
+            f"{_f(s['median_removed_deg'])} ({s['halving_within_reach']}/{n})"
+            if "halving_within_reach" in s
+            else "-"
+        )
         lines.append(
             f"| {effect.replace('_', ' ')} | {first} | {s['halved']}/{n} | {both} | "
             f"{_f(s['median_before_deg'])} → {_f(s['median_after_deg'])} | "
-            f"{_f(s['median_footprint_deg'])} | {named} |"
+            f"{_f(s['median_footprint_deg'])} | {reach} | {named} |"
         )
     lines += [
         "",
@@ -331,6 +388,8 @@ def plot(doc: dict[str, Any], path: Path) -> None:
             ax.plot(x, b, "o", mfc="white", mec="C0")
             ax.plot(x, a, "o", color="C2" if r["passed"] else "C3")
             ax.plot(x, r["footprint_psi_deg"], "x", color="0.3", ms=5)
+            if "removed_psi_deg" in r:
+                ax.plot(x, r["removed_psi_deg"], "v", color="C1", ms=5)
     ax.set_xticks(range(len(effects)), [e.replace("_", " ") for e in effects])
     ax.set_yscale("log")
     ax.yaxis.set_major_formatter(ScalarFormatter())
@@ -342,6 +401,8 @@ def plot(doc: dict[str, Any], path: Path) -> None:
         Line2D([], [], ls="", marker="o", color="C2", label="after, passed"),
         Line2D([], [], ls="", marker="o", color="C3", label="after, missed"),
         Line2D([], [], ls="", marker="x", color="0.3", label="the true hull ignoring the effect"),
+        Line2D([], [], ls="", marker="v", color="C1",
+               label="the base structure on the records with the effect taken out"),
     ], fontsize=8)  # fmt: skip
     ax = axes[1]
     n = doc["n_seeds"]
@@ -445,7 +506,13 @@ def main(argv: list[str] | None = None) -> int:
         print(
             f"{effect:>14}: {what}, held-out heading halved {s['halved']}/{s['seeds']}, "
             f"median {_f(s['median_before_deg'])} -> {_f(s['median_after_deg'])} deg"
-            f"{'' if s['target_met'] else '  (target missed)'}"
+            + (
+                f"; the effect taken out {_f(s['median_removed_deg'])} deg, halving within "
+                f"reach {s['halving_within_reach']}/{s['seeds']}"
+                if "halving_within_reach" in s
+                else ""
+            )
+            + ("" if s["target_met"] else "  (target missed)")
         )
     write_json(doc, out / f"{name}.json")
     plot(doc, out / f"{name}.png")

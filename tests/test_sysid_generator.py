@@ -18,9 +18,11 @@ carries the ship, the recorded apparent wind adds up to the true wind).
 
 from __future__ import annotations
 
+import importlib.util
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -646,6 +648,37 @@ def test_mmg_current_only_carries_the_ship() -> None:
         np.testing.assert_allclose(cur.y - rc.y, p["V_e"] * cur.time, atol=1e-7)
         u_c = p["V_n"] * np.cos(cur.psi) + p["V_e"] * np.sin(cur.psi)
         np.testing.assert_allclose(cur.u - rc.u, u_c, atol=1e-9)
+
+
+def test_mmg_report_takes_each_effect_back_out_of_the_records() -> None:
+    """The MMG report's bound (``scripts/identify_mmg_records.py``, ``effect_removed``): from a
+    record's truth it gives the rudder the ship felt (the gear's actual angle of the slow
+    gear, the recorded rudder tau later, or plus the zero error) and, for a current, the
+    clean record's motion through the water."""
+    spec = importlib.util.spec_from_file_location(
+        "identify_mmg_records", Path(__file__).parents[1] / "scripts" / "identify_mmg_records.py"
+    )
+    assert spec is not None and spec.loader is not None
+    report = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(report)
+    for rc, back in zip(_mmg(None, seed=4), report.effect_removed(_mmg("current", seed=4)),
+                        strict=True):  # fmt: skip
+        for k in ("x", "y", "u", "v", "U", "psi", "delta"):
+            np.testing.assert_allclose(getattr(back, k), getattr(rc, k), atol=1e-9)
+    rec = _mmg("rudder_lag", seed=2, dt=0.05)[0]
+    t_d = rec.meta["truth"]["effect_parameters"]["T_delta"]
+    actual = _direct(rec, lambda t: rec.delta[: t.size], rudder_time_constant=t_d)["delta"]
+    felt = report.effect_removed([rec])[0].delta
+    assert np.max(np.abs(felt - rec.delta)) > math.radians(10.0)  # the gear lags the order
+    np.testing.assert_allclose(felt[: actual.size], actual[: felt.size], atol=1e-9)
+    rec = _mmg("input_delay", seed=3, dt=0.05)[1]
+    d = round(rec.meta["truth"]["effect_parameters"]["tau"] / rec.dt)
+    felt = report.effect_removed([rec])[0].delta
+    np.testing.assert_allclose(felt[d:], rec.delta[:-d], atol=1e-12)
+    rec = _mmg("rudder_offset", seed=0)[1]
+    felt = report.effect_removed([rec])[0].delta
+    d0 = rec.meta["truth"]["effect_parameters"]["delta_0"]
+    np.testing.assert_allclose(felt - rec.delta, d0, atol=1e-12)
 
 
 def test_mmg_wind_records_the_apparent_wind_of_a_constant_true_wind() -> None:
