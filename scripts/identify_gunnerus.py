@@ -47,6 +47,7 @@ from shipgym.models import RVGParams
 from shipgym.models.rvg import SEA_TRIALS_VALUES
 from shipgym.sysid import identify, load
 from shipgym.sysid import manoeuvres as mn
+from shipgym.sysid.consistency import kinematic_consistency
 from shipgym.sysid.families.base import jsonable, window_starts
 from shipgym.sysid.families.rvg import (
     CALIBRATED,
@@ -180,6 +181,18 @@ def main(argv: list[str] | None = None) -> int:
             e = (e + np.pi) % (2 * np.pi) - np.pi
         seed_rms[ch] = float(np.sqrt(np.mean(e**2)))
     plot_loop(res.heldout["path"], seed_rms, out / "gunnerus_loop.png")
+    # the record's own floor: its yaw rate and velocities integrated from each window's start
+    cons = kinematic_consistency(rec, ctx_starts)
+    held_w = rec.time[ctx_starts] >= rec.time[0] + res.heldout["from_s"]
+    scales = cons.yaw_rate_scale[np.isfinite(cons.yaw_rate_scale)]
+    consistency = {
+        "heldout_heading_rms_deg": math.degrees(cons.pooled_heading_rms(held_w)),
+        "heldout_median_window_deg": math.degrees(float(np.median(cons.heading_rms[held_w]))),
+        "training_heading_rms_deg": math.degrees(cons.pooled_heading_rms(~held_w)),
+        "heldout_position_rms_m": cons.pooled_position_rms(held_w),
+        "yaw_rate_scale_5_95": [float(q) for q in np.percentile(scales, [5, 95])],
+        "turning_windows": int(scales.size),
+    }
 
     # cross-validation by manoeuvre
     ms = mn.extract_manoeuvres(rec)
@@ -220,6 +233,7 @@ def main(argv: list[str] | None = None) -> int:
         "loop_runtime_s": loop_s,
         "identification": res.to_dict(),
         "heldout_seed001": seed_rms,
+        "record_consistency": consistency,
         "at_bound": list(final.at_bound),
         "sea_trials_values": values,
         "shipped_sea_trials_values": SEA_TRIALS_VALUES,
@@ -245,6 +259,20 @@ def main(argv: list[str] | None = None) -> int:
     for key, name in shown:
         a, b, c = (held_err[k][key] for k in ("error_seed001", "error_before", "error_after"))
         lines.append(f"| {name} | {a:.2f} | {b:.2f} | {c:.2f} |")
+    lo, hi = consistency["yaw_rate_scale_5_95"]
+    lines += [
+        "",
+        "The record itself (`shipgym.sysid.consistency`): its measured yaw rate, integrated "
+        "from each held-out window's start, misses its measured heading by "
+        f"{consistency['heldout_heading_rms_deg']:.2f} deg RMS (median window "
+        f"{consistency['heldout_median_window_deg']:.2f} deg; the training windows "
+        f"{consistency['training_heading_rms_deg']:.2f} deg), and its u, v integrated with the "
+        f"heading miss its positions by {consistency['heldout_position_rms_m']:.1f} m. A model "
+        "that predicted the measured yaw rate exactly would keep that heading error. The "
+        "factor on r that fits each window's heading change (the "
+        f"{consistency['turning_windows']} windows that turn 10 deg or more) ranges "
+        f"{lo:.2f}-{hi:.2f} (5-95 %).",
+    ]
     lines += ["", f"{len(ms)} manoeuvres extracted from the record, cross-validated by manoeuvre "
               f"({args.folds} folds: each is predicted by the final model fitted on the record "
               "without it, in the day's current fitted with it; the shipped `sea_trials` set, "
