@@ -181,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
             e = (e + np.pi) % (2 * np.pi) - np.pi
         seed_rms[ch] = float(np.sqrt(np.mean(e**2)))
     plot_loop(res.heldout["path"], seed_rms, out / "gunnerus_loop.png")
-    # the record's own floor: its yaw rate and velocities integrated from each window's start
+    # the record itself: its yaw rate and velocities integrated from each window's start
     cons = kinematic_consistency(rec, ctx_starts)
     held_w = rec.time[ctx_starts] >= rec.time[0] + res.heldout["from_s"]
     scales = cons.yaw_rate_scale[np.isfinite(cons.yaw_rate_scale)]

@@ -10,9 +10,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from shipgym.sysid import identify
 from shipgym.sysid.consistency import kinematic_consistency
 from shipgym.sysid.families.base import window_starts
-from shipgym.sysid.generator import MMG_NOISE, generate_mmg_runs
+from shipgym.sysid.generator import MMG_NOISE, generate_mmg_runs, generate_record
 
 WINDOW_S = 60.0
 
@@ -92,3 +93,31 @@ def test_pooled_over_chosen_windows_and_without_a_track(quiet_runs) -> None:
     for starts in ([1, 50], [0, 50, 51], [0, rec.time.size - 1], [0.0, 50.0], []):
         with pytest.raises(ValueError, match="starts must be increasing sample indices from 0"):
             kinematic_consistency(rec, np.array(starts))
+
+
+def test_identify_reports_the_held_out_windows_consistency() -> None:
+    """``identify`` reports the record's own consistency over its held-out windows: the pooled
+    consistency of exactly those windows. A yaw-rate sensor reading 10 % high raises it to a
+    tenth of the heading the held-out windows turn through; a free run (no windows) has
+    none."""
+    rec = generate_record(None, maneuver="zigzag", seed=3)
+    for r_scale in (1.0, 1.1):
+        bad = replace(rec, r=r_scale * rec.r)
+        res = identify(bad, "nomoto1", window_s=100.0, max_effects=0)
+        starts = np.asarray(res.traces["window_starts"])
+        c = kinematic_consistency(bad, starts)
+        held = c.starts >= res.traces["split"]
+        floor = res.heldout["record_consistency"]
+        assert floor["psi_rms_deg"] == pytest.approx(
+            math.degrees(c.pooled_heading_rms(held)), rel=1e-12
+        )
+        if r_scale == 1.0:
+            assert floor["psi_rms_deg"] < 0.5
+        else:
+            turned = [bad.psi[i0 + 1 : i1] - bad.psi[i0] for i0, i1 in
+                      zip(starts, np.append(starts[1:], bad.n), strict=True)
+                      if i0 >= res.traces["split"]]  # fmt: skip
+            tenth = 0.1 * math.sqrt(np.mean(np.concatenate(turned) ** 2))
+            assert floor["psi_rms_deg"] == pytest.approx(math.degrees(tenth), rel=0.1)
+    free = identify(rec, "nomoto1", window_s=None, max_effects=0)
+    assert "record_consistency" not in free.heldout

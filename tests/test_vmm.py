@@ -24,8 +24,9 @@ from shipgym.models.vmm import (
     term_matrix,
 )
 from shipgym.sysid import identify, load
+from shipgym.sysid.consistency import kinematic_consistency
 from shipgym.sysid.data import measured_root
-from shipgym.sysid.families.base import actual_rudder
+from shipgym.sysid.families.base import actual_rudder, window_starts
 from shipgym.sysid.families.vmm import (
     ASYMMETRY_TERMS,
     RegressionResult,
@@ -260,6 +261,25 @@ def test_the_undeclared_wind_is_named_and_the_coefficients_come_back(wind_fit, w
         assert abs(z) < 3.0, (name, z)
     held = wind_fit.heldout
     assert held["error_after"]["psi_rms_deg"] < 0.3 * held["error_before"]["psi_rms_deg"]
+
+
+def test_the_held_out_runs_own_consistency_is_reported(wind_fit, wind_runs) -> None:
+    """The held-out runs' kinematic consistency (what their yaw rate and velocities integrated
+    from each scoring window's start miss of their heading and track) is the pooled
+    :func:`kinematic_consistency` of exactly those runs and windows; on simulated runs with
+    0.1 deg heading noise it is that noise's size."""
+    held = wind_fit.heldout
+    idx = held["run_indices"]
+    assert [wind_runs[i].meta["file"] for i in idx] == held["runs"]
+    checks = [kinematic_consistency(wind_runs[i], window_starts(
+        wind_runs[i].time, wind_fit.window_s)) for i in idx]  # fmt: skip
+    n = sum(int(c.samples.sum()) for c in checks)
+    psi = math.sqrt(sum(float(c.samples @ c.heading_rms**2) for c in checks) / n)
+    xy = math.sqrt(sum(float(c.samples @ c.position_rms**2) for c in checks) / n)
+    floor = held["record_consistency"]
+    assert floor["psi_rms_deg"] == pytest.approx(math.degrees(psi), rel=1e-12)
+    assert floor["xy_rms_m"] == pytest.approx(xy, rel=1e-12)
+    assert 0.1 < floor["psi_rms_deg"] < 0.3
 
 
 def test_a_clean_ship_gets_no_effect() -> None:

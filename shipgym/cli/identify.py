@@ -201,6 +201,15 @@ def _identify_summary(result: Any, source: str) -> str:
             f"held-out {where} (models fitted on the rest): "
             f"{format_errors(held['error_before'], held['error_after'])}"
         )
+        own = held.get("record_consistency")
+        if own:
+            track = f", its track by {own['xy_rms_m']:.3g} m" if "xy_rms_m" in own else ""
+            lines.append(
+                "  the record itself there: its yaw rate and velocities, integrated from each "
+                f"window's start, miss its heading by {own['psi_rms_deg']:.3g} deg{track} (a "
+                "model's heading error and its integrated yaw-rate error add up to at least "
+                "this)"
+            )
     final = (result.diagnostics or {}).get("final", {})
     if final.get("collinear"):
         lines.append("terms left out as collinear (pivoted QR), with the terms they follow:")

@@ -5,7 +5,7 @@
   their registry (:func:`load`, :func:`detect_format`); ``shipgym.sysid.ingest``: the steps
   every loader shares (unit checks, repairs); ``shipgym.sysid.data`` gathers their names.
 * ``shipgym.sysid.consistency``: whether a record's rate channels integrate to its heading and
-  track (the floor under any model's windowed prediction error).
+  track (what a model fitted to both must miss of one or the other).
 * ``shipgym.sysid.fit``: equation-error and output-error fits of the Nomoto-family models with
   standard errors (seed 000, seed 002 eq. 4-5, seed 004 eq. 1-4).
 * ``shipgym.sysid.recursive``: recursive least squares with forgetting and the adaptive

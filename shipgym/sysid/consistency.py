@@ -8,13 +8,17 @@ north/east rows of ``eta' = R(psi) nu``, Fossen 2021 eq. 2.40 and 2.62)::
 
 hold whatever the ship's dynamics. Integrated from the measured state at the start of each
 window, the rate channels must reproduce the heading and the track up to their sensors' noise.
-What they miss is a floor under any model's windowed prediction error that the model cannot
-remove: a model that predicted the measured ``r`` exactly would still miss the measured
-heading by it. This is the *data compatibility check* of flight-test identification (Klein and
-Morelli, *Aircraft System Identification*, AIAA 2006, chapter 10), where the rates' scale
-factors and biases are estimated before any model is fitted; here the scale factors are
-estimated per window and pooled, a channel timed on another clock shows as a scale that varies
-from window to window, a unit slip (knots taken with the wrong factor) as one that does not.
+What they miss binds every model fitted to both: its heading error and the integral of its
+yaw-rate error add up to at least it (``psi_model - psi = integral of (r_model - r) +
+(psi(t0) + integral of r - psi)``), so a model that predicted the measured ``r`` exactly would
+miss the measured heading by it, and one that met the heading would miss the yaw rate. The
+integrated white noise of ``r`` is part of it without binding a model, whose rate is smooth; a
+scale or timing error of a channel binds. This is the *data compatibility check* of
+flight-test identification (Klein and Morelli, *Aircraft System Identification*, AIAA 2006,
+chapter 10), where the rates' scale factors and biases are estimated before any model is
+fitted. Here the scale factors are estimated per window: a channel timed on another clock shows
+as a scale that varies from window to window, a unit slip (knots taken with the wrong factor) as
+one that does not.
 """
 
 from __future__ import annotations

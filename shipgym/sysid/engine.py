@@ -48,8 +48,16 @@ from threadpoolctl import threadpool_limits
 
 from shipgym.models import ShipModel, VMMParams
 from shipgym.models.model_file import load_model
+from shipgym.sysid.consistency import kinematic_consistency
 from shipgym.sysid.data import Record
-from shipgym.sysid.families.base import Candidate, ModelFamily, Verdict, get_family, jsonable
+from shipgym.sysid.families.base import (
+    Candidate,
+    ModelFamily,
+    Verdict,
+    get_family,
+    jsonable,
+    window_starts,
+)
 from shipgym.sysid.fit import excitation_problems, no_excitation_error
 
 __all__ = ["IdentificationResult", "identify"]
@@ -90,7 +98,11 @@ class IdentificationResult:
         ``from_s`` (start of the held-out part, seconds from the record start),
         ``error_before`` and ``error_after``: the same errors over the held-out part for the
         models fitted on the training part only; ``path``: the held-out error after the base
-        and after each accepted effect.
+        and after each accepted effect; ``record_consistency``: what the record's own yaw rate
+        (and velocities) miss of its heading (and track) in the held-out windows, integrated
+        from each window's measured start (``psi_rms_deg``, ``xy_rms_m``;
+        :mod:`shipgym.sysid.consistency`: a model's heading error and its integrated yaw-rate
+        error there add up to at least it), where the windows are known.
     traces : dict
         ``time``, ``split`` (first held-out index), ``window_starts`` (indices) and, per channel,
         ``{"measured", "before", "after"}`` arrays of the whole-record simulations.
@@ -213,6 +225,50 @@ def _split_segments(
             f"{longest.time[-1]:g} s ({longest.n} samples)"
         )
         out.append(longest)
+    return out
+
+
+def _record_consistency(
+    runs: Sequence[Record], report: dict[str, Any], window: float | None
+) -> dict[str, float] | None:
+    """What the records' own rates miss of their heading and track in the held-out windows
+    (:func:`~shipgym.sysid.consistency.kinematic_consistency`, each window from its measured
+    start): ``psi_rms_deg`` and, with positions and velocities, ``xy_rms_m``; None when the
+    held-out windows are not known."""
+    held = report.get("heldout") or {}
+    traces = report.get("traces") or {}
+    parts: list[tuple[Any, np.ndarray]] = []  # (consistency, held-out windows)
+    try:
+        if "run_indices" in held:  # several runs: the held-out ones, each cut into windows
+            for i in held["run_indices"]:
+                rec = runs[i]
+                check = kinematic_consistency(rec, window_starts(rec.time, window))
+                parts.append((check, np.ones(check.starts.size, dtype=bool)))
+        elif "split" in traces and "window_starts" in traces:
+            check = kinematic_consistency(runs[0], np.asarray(traces["window_starts"]))
+            parts.append((check, check.starts >= traces["split"]))
+    except ValueError:  # windows too short to compare
+        return None
+    if not parts or not any(w.any() for _, w in parts):
+        return None
+
+    def pooled(values: Callable[[Any], np.ndarray | None]) -> float | None:
+        num = den = 0.0
+        for check, w in parts:
+            v = values(check)
+            if v is None:
+                return None
+            num += float(np.sum(check.samples[w] * v[w] ** 2))
+            den += float(np.sum(check.samples[w]))
+        return math.sqrt(num / den) if den else None
+
+    psi = pooled(lambda c: c.heading_rms)
+    if psi is None:
+        return None
+    out = {"psi_rms_deg": math.degrees(psi)}
+    xy = pooled(lambda c: c.position_rms)
+    if xy is not None:
+        out["xy_rms_m"] = xy
     return out
 
 
@@ -399,6 +455,9 @@ def identify(
     if not verdict.identifiable:
         say("not identifiable: " + "; ".join(verdict.reasons))
     report["heldout"]["path"] = path
+    consistency = _record_consistency(runs, report, window)
+    if consistency is not None:
+        report["heldout"]["record_consistency"] = consistency
     return IdentificationResult(
         model=model_name,
         effects=effects,

@@ -1481,6 +1481,7 @@ class VMMFamily(ModelFamily):
             say(note)
         heldout = {
             "runs": [ctx.runs[i].name for i in ctx.held],
+            "run_indices": list(ctx.held),
             "notes": list(ctx.holdout_notes),
             "error_before": _rms(held_sims["before"][held_mask], ctx.rp.measured[held_mask]),
             "error_after": _rms(held_sims["after"][held_mask], ctx.rp.measured[held_mask]),
