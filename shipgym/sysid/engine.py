@@ -48,7 +48,7 @@ from threadpoolctl import threadpool_limits
 
 from shipgym.models import ShipModel, VMMParams
 from shipgym.models.model_file import load_model
-from shipgym.sysid.consistency import kinematic_consistency
+from shipgym.sysid.consistency import KinematicConsistency, kinematic_consistency
 from shipgym.sysid.data import Record
 from shipgym.sysid.families.base import (
     Candidate,
@@ -237,7 +237,7 @@ def _record_consistency(
     held-out windows are not known."""
     held = report.get("heldout") or {}
     traces = report.get("traces") or {}
-    parts: list[tuple[Any, np.ndarray]] = []  # (consistency, held-out windows)
+    parts: list[tuple[KinematicConsistency, np.ndarray]] = []  # (a record, its held windows)
     try:
         if "run_indices" in held:  # several runs: the held-out ones, each cut into windows
             for i in held["run_indices"]:
@@ -249,26 +249,19 @@ def _record_consistency(
             parts.append((check, check.starts >= traces["split"]))
     except ValueError:  # windows too short to compare
         return None
-    if not parts or not any(w.any() for _, w in parts):
+    parts = [(check, w) for check, w in parts if w.any()]
+    if not parts:
         return None
-
-    def pooled(values: Callable[[Any], np.ndarray | None]) -> float | None:
-        num = den = 0.0
-        for check, w in parts:
-            v = values(check)
-            if v is None:
-                return None
-            num += float(np.sum(check.samples[w] * v[w] ** 2))
-            den += float(np.sum(check.samples[w]))
-        return math.sqrt(num / den) if den else None
-
-    psi = pooled(lambda c: c.heading_rms)
-    if psi is None:
-        return None
-    out = {"psi_rms_deg": math.degrees(psi)}
-    xy = pooled(lambda c: c.position_rms)
-    if xy is not None:
-        out["xy_rms_m"] = xy
+    n = sum(int(np.sum(check.samples[w])) for check, w in parts)
+    out = {
+        "psi_rms_deg": math.degrees(math.sqrt(sum(
+            check.pooled_heading_rms(w) ** 2 * np.sum(check.samples[w]) for check, w in parts
+        ) / n)),
+    }  # fmt: skip
+    if all(check.position_rms is not None for check, _ in parts):
+        out["xy_rms_m"] = math.sqrt(sum(
+            check.pooled_position_rms(w) ** 2 * np.sum(check.samples[w]) for check, w in parts
+        ) / n)  # fmt: skip
     return out
 
 

@@ -1187,6 +1187,7 @@ class _Context:
     term_set: str
     selection: dict[str, Any] = field(default_factory=dict)  # vmm:auto's choice of term set
     holdout_notes: list[str] = field(default_factory=list)  # held-out runs without a partner
+    split_in_time: bool = False  # one record cut into a training and a held-out part
 
 
 def _prediction_errors(fit: VMMFit, rp: _Replay, runs: Sequence[int]) -> np.ndarray | None:
@@ -1280,6 +1281,7 @@ class VMMFamily(ModelFamily):
         if template.thrust_from == "rps":
             records = [replace(r, thrust=None) if r.thrust is not None else r for r in records]
         holdout_notes: list[str] = []
+        split_in_time = False
         if len(records) == 1:  # one run: split in time
             rec = records[0]
             cut = _cut(rec)
@@ -1287,6 +1289,7 @@ class VMMFamily(ModelFamily):
             records = [cut.slice(float(cut.time[0]), t_split),
                        cut.slice(t_split, float(cut.time[-1]))]  # fmt: skip
             train, held = [0], [1]
+            split_in_time = True
         else:
             held, holdout_notes = holdout_runs(
                 [r.delta for r in records],
@@ -1304,7 +1307,7 @@ class VMMFamily(ModelFamily):
         shooting = REFINE_WINDOW_LENGTHS * lengths_s
         rp_fit = _build_replay(runs, template, min(shooting, window_s or math.inf))
         return _Context(runs, rp, rp_fit, train, held, template, window_s, self.term_set,
-                        holdout_notes=holdout_notes)  # fmt: skip
+                        holdout_notes=holdout_notes, split_in_time=split_in_time)  # fmt: skip
 
     def _score(self, ctx: _Context, fit: VMMFit) -> Candidate:
         """Held-out runs replayed with each window's initial sway and yaw rate estimated
@@ -1481,7 +1484,8 @@ class VMMFamily(ModelFamily):
             say(note)
         heldout = {
             "runs": [ctx.runs[i].name for i in ctx.held],
-            "run_indices": list(ctx.held),
+            # the held-out records among those given (a record cut in time is not one of them)
+            **({} if ctx.split_in_time else {"run_indices": list(ctx.held)}),
             "notes": list(ctx.holdout_notes),
             "error_before": _rms(held_sims["before"][held_mask], ctx.rp.measured[held_mask]),
             "error_after": _rms(held_sims["after"][held_mask], ctx.rp.measured[held_mask]),
