@@ -7,6 +7,15 @@ computed them: one single env (``gymnasium.make``) stepped episode after episode
 controllers on Python floats, one ``info`` dict logged per step. It was written by running
 ``_cell_batch(...).run()`` of ``shipgym.benchmark.runner`` for every cell at that commit and
 keeping ``to_dict()``'s ``returns``, ``per_episode``, ``termination`` and ``length``.
+
+The terminations must match exactly, and the lengths, returns and metrics bit for bit, as
+they do on the CPU the reference was made on. On another CPU numpy's vectorised sines and
+arctangents (its SIMD dispatch: AVX-512 there, AVX2 on another machine) can differ in the last
+bit, and over a closed-loop episode of the path-following task under the classic LOS
+controllers that bit grows. Measured on an AVX2 machine: every other cell bit for bit, and in 6
+of the 21 path-following cells the returns up to 0.54 % off and the lengths up to 7 of 800
+steps. A cell whose returns are not bitwise the reference's must still have its terminations,
+its returns within 1 % and its lengths within 1 %; its metrics are then not compared.
 """
 
 from __future__ import annotations
@@ -26,16 +35,20 @@ REFERENCE = json.loads(
     (Path(__file__).parent / "data" / "benchmark_cells_reference.json").read_text()
 )["cells"]
 EPISODES = len(REFERENCE[0]["returns"])
+PORTABLE_RTOL = 1e-2
+"""Relative tolerance of the returns and lengths across CPUs (module docstring)."""
 
 
-def _same(got: list[float], want: list[float], what: str) -> None:
+def _same(got: list[float], want: list[float], what: str, rtol: float = 0.0) -> bool:
+    """Whether ``got`` is bitwise ``want``; fails unless it is within ``rtol`` of it."""
     got_a = np.asarray(got, dtype=float)
     want_a = np.asarray(want, dtype=float)
     assert got_a.shape == want_a.shape, what
     assert np.array_equal(np.isnan(got_a), np.isnan(want_a)), what
-    assert np.array_equal(got_a, want_a, equal_nan=True), (
+    assert np.allclose(got_a, want_a, rtol=rtol, atol=0.0, equal_nan=True), (
         f"{what}: {got_a.tolist()} != {want_a.tolist()}"
     )
+    return bool(np.array_equal(got_a, want_a, equal_nan=True))
 
 
 @pytest.mark.parametrize("env_id", CURRENT_ENV_IDS)
@@ -50,11 +63,13 @@ def test_every_benchmark_cell_gives_the_reference_numbers(env_id: str) -> None:
             BENCHMARK_SEED, None, 0,
         ).run()  # fmt: skip
         what = f"{env_id} {ref['controller']} {label}"
-        assert result.lengths == ref["length"], what
         assert result.terminations == ref["termination"], what
-        _same(result.returns, ref["returns"], f"{what} returns")
-        for key, values in ref["per_episode"].items():
-            _same(result.values(key).tolist(), values, f"{what} {key}")
+        if _same(result.returns, ref["returns"], f"{what} returns", PORTABLE_RTOL):
+            assert result.lengths == ref["length"], what
+            for key, values in ref["per_episode"].items():
+                _same(result.values(key).tolist(), values, f"{what} {key}")
+        else:  # another CPU's last bits (module docstring)
+            _same(result.lengths, ref["length"], f"{what} lengths", PORTABLE_RTOL)
         assert not any(math.isnan(r) for r in result.returns) or result.blown_up, what
 
 

@@ -26,6 +26,11 @@ kinematic ship, seeded with ``numpy.random.default_rng([2804, ...])``:
 
 The file stores what the guidance was given (times, positions, yaw rates, targets, initial
 courses) and everything it returned and reported at each update. Nothing is regenerated here.
+
+A batch row and its ship alone must agree bit for bit in the same run. Against the file, the
+segments, flags and modes must match exactly and the floats to 1e-12. The file was made on a
+CPU whose numpy computes arctangents with AVX-512 code; with AVX2 they can differ in the last
+bit (measured: 45 of 300 courses 1 ulp apart).
 """
 
 from __future__ import annotations
@@ -107,6 +112,17 @@ def _assert_bitwise(got: np.ndarray, want: np.ndarray, what: str) -> None:
     np.testing.assert_array_equal(got, want, err_msg=what, strict=True)
 
 
+def _assert_reference(got: np.ndarray, want: np.ndarray, what: str) -> None:
+    """``got`` is the file's ``want``: exactly for integers and flags, to 1e-12 for floats
+    (module docstring)."""
+    got = np.asarray(got)
+    assert got.shape == want.shape and got.dtype == want.dtype, what
+    if want.dtype.kind == "f":
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12, err_msg=what)
+    else:
+        np.testing.assert_array_equal(got, want, err_msg=what, strict=True)
+
+
 @pytest.mark.parametrize("name", list(LOS_CONFIGS))
 def test_los_reproduces_the_one_ship_code_alone_and_in_a_batch(golden, name: str) -> None:
     cls, kwargs, kind = LOS_CONFIGS[name]
@@ -129,8 +145,8 @@ def test_los_reproduces_the_one_ship_code_alone_and_in_a_batch(golden, name: str
     for j, key in enumerate(LOS_READOUTS):
         want = golden[f"{name}/{key}"]
         one = np.array([[row[j] for row in rows] for rows in alone], dtype=want.dtype)
-        _assert_bitwise(one, want, f"{name} {key}, ships alone")
-        _assert_bitwise(np.stack([row[j] for row in together], axis=1).astype(want.dtype), want,
+        _assert_reference(one, want, f"{name} {key}, ships alone")
+        _assert_bitwise(np.stack([row[j] for row in together], axis=1).astype(want.dtype), one,
                         f"{name} {key}, batch")  # fmt: skip
     # the runs cover what they are meant to: switching, finishing, the integrator's modes
     assert np.all(golden[f"{name}/seg"][:, -1] == golden["n_waypoints"] - 2)
@@ -167,10 +183,10 @@ def test_constant_bearing_reproduces_the_one_ship_code_alone_and_in_a_batch(
     together = [step(batch, k, slice(None)) for k in range(steps)]
     for j, key in enumerate(CB_READOUTS):
         want = golden[f"{name}/{key}"]
-        _assert_bitwise(np.array([[row[j] for row in rows] for rows in alone]), want,
-                        f"{name} {key}, ships alone")  # fmt: skip
+        one = np.array([[row[j] for row in rows] for rows in alone])
+        _assert_reference(one, want, f"{name} {key}, ships alone")
         _assert_bitwise(
-            np.stack([row[j] for row in together], axis=1), want, f"{name} {key}, batch"
+            np.stack([row[j] for row in together], axis=1), one, f"{name} {key}, batch"
         )
     if given:  # the special updates: on the target, and the course held at the aim point
         assert np.all(golden[f"{name}/range"][:, 20] == 0.0)
