@@ -266,6 +266,90 @@ def _record_consistency(
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # the fits run side by side (pyproject)
+@dataclass
+class _Trace:
+    """One run of the loop from a base model: the accepted effects and every round's scores."""
+
+    base: Candidate
+    current: Candidate
+    effects: list[dict[str, Any]]
+    rounds: list[dict[str, Any]]
+    path: list[dict[str, Any]]
+
+
+def _trace_effects(
+    family: ModelFamily, ctx: Any, base: Candidate, max_effects: int, say: Callable[[str], None]
+) -> _Trace:
+    """Steps 2-4 of the loop (module docstring) from ``base``."""
+    current = base
+    path: list[dict[str, Any]] = [{"model": family.name, "heldout_rms": dict(base.heldout_rms)}]
+    effects: list[dict[str, Any]] = []
+    rounds: list[dict[str, Any]] = []
+    while len(effects) < max_effects:
+        scored: dict[str, dict[str, Any]] = {}
+        good: dict[str, tuple[Candidate, float]] = {}
+        names = list(family.candidates(current))
+        t0 = time.perf_counter()
+        if family.concurrent_candidates and len(names) > 1:
+            with ThreadPoolExecutor(max_workers=min(len(names), os.cpu_count() or 1)) as pool:
+                outcomes = list(pool.map(lambda n, c=current: _try(family, ctx, c, n), names))
+        else:
+            outcomes = [_try(family, ctx, current, n) for n in names]
+        for name, cand in zip(names, outcomes, strict=True):
+            if isinstance(cand, Exception):
+                say(f"  {name}: fit failed ({cand})")
+                scored[name] = {
+                    "delta_J": math.inf,
+                    "relative_drop": -math.inf,
+                    "significant": False,
+                    "error": str(cand),
+                }
+                continue
+            dj, drop = family.compare(current, cand, name)
+            ok = family.significant(cand, name, dj, drop)
+            scored[name] = {  # the family's scalar extras, never over the engine's own keys
+                **{k: v for k, v in cand.extra.items() if isinstance(v, int | float | str)},
+                "delta_J": dj,
+                "relative_drop": drop,
+                "significant": ok,
+                "heldout_rms": dict(cand.heldout_rms),
+            }
+            if ok:
+                good[name] = (cand, dj)
+            say(f"  {name}: dJ {dj:.1f}, held-out drop {100 * drop:.1f} %, significant {ok}")
+        say(f"  ({len(names)} candidates in {time.perf_counter() - t0:.1f} s)")
+        rounds.append(scored)
+        if not good:
+            break
+        best = family.choose(good)
+        cand = good[best][0]
+        before = dict(current.heldout_rms)
+        current = family.accept(ctx, current, cand, best)
+        # a family's own evidence: its extras named ``evidence_<key>``, reported as ``<key>``
+        evidence = {
+            k.removeprefix("evidence_"): v
+            for k, v in cand.extra.items()
+            if k.startswith("evidence_")
+        }
+        evidence.update(
+            delta_J=scored[best]["delta_J"],
+            relative_drop=scored[best]["relative_drop"],
+            heldout_rms_before=before,
+            heldout_rms_after=dict(current.heldout_rms),
+        )
+        effects.append(
+            {
+                "name": best,
+                "parameters": family.effect_parameters(current.fitted, best),
+                "evidence": evidence,
+            }
+        )
+        path.append({"model": f"+ {best}", "heldout_rms": dict(current.heldout_rms)})
+        say(f"accepted {best}")
+
+    return _Trace(base, current, effects, rounds, path)
+
+
 def identify(
     record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
@@ -368,75 +452,20 @@ def identify(
     window = getattr(ctx, "window_s", window)  # a family may resolve "auto" from the record
 
     t0 = time.perf_counter()
-    base = current = family.fit_base(ctx, say)
-    say(
-        f"base {family.name}: held-out error {current.heldout_error:.4g} "
-        f"({time.perf_counter() - t0:.1f} s)"
-    )
-    path: list[dict[str, Any]] = [{"model": family.name, "heldout_rms": dict(base.heldout_rms)}]
-    effects: list[dict[str, Any]] = []
-    rounds: list[dict[str, Any]] = []
-    while len(effects) < max_effects:
-        scored: dict[str, dict[str, Any]] = {}
-        good: dict[str, tuple[Candidate, float]] = {}
-        names = list(family.candidates(current))
-        t0 = time.perf_counter()
-        if family.concurrent_candidates and len(names) > 1:
-            with ThreadPoolExecutor(max_workers=min(len(names), os.cpu_count() or 1)) as pool:
-                outcomes = list(pool.map(lambda n, c=current: _try(family, ctx, c, n), names))
-        else:
-            outcomes = [_try(family, ctx, current, n) for n in names]
-        for name, cand in zip(names, outcomes, strict=True):
-            if isinstance(cand, Exception):
-                say(f"  {name}: fit failed ({cand})")
-                scored[name] = {
-                    "delta_J": math.inf,
-                    "relative_drop": -math.inf,
-                    "significant": False,
-                    "error": str(cand),
-                }
-                continue
-            dj, drop = family.compare(current, cand, name)
-            ok = family.significant(cand, name, dj, drop)
-            scored[name] = {  # the family's scalar extras, never over the engine's own keys
-                **{k: v for k, v in cand.extra.items() if isinstance(v, int | float | str)},
-                "delta_J": dj,
-                "relative_drop": drop,
-                "significant": ok,
-                "heldout_rms": dict(cand.heldout_rms),
-            }
-            if ok:
-                good[name] = (cand, dj)
-            say(f"  {name}: dJ {dj:.1f}, held-out drop {100 * drop:.1f} %, significant {ok}")
-        say(f"  ({len(names)} candidates in {time.perf_counter() - t0:.1f} s)")
-        rounds.append(scored)
-        if not good:
-            break
-        best = family.choose(good)
-        cand = good[best][0]
-        before = dict(current.heldout_rms)
-        current = family.accept(ctx, current, cand, best)
-        # a family's own evidence: its extras named ``evidence_<key>``, reported as ``<key>``
-        evidence = {
-            k.removeprefix("evidence_"): v
-            for k, v in cand.extra.items()
-            if k.startswith("evidence_")
-        }
-        evidence.update(
-            delta_J=scored[best]["delta_J"],
-            relative_drop=scored[best]["relative_drop"],
-            heldout_rms_before=before,
-            heldout_rms_after=dict(current.heldout_rms),
-        )
-        effects.append(
-            {
-                "name": best,
-                "parameters": family.effect_parameters(current.fitted, best),
-                "evidence": evidence,
-            }
-        )
-        path.append({"model": f"+ {best}", "heldout_rms": dict(current.heldout_rms)})
-        say(f"accepted {best}")
+    starts = family.fit_bases(ctx, say)
+    say(f"base {family.name}: held-out error {starts[0][1].heldout_error:.4g} "
+        f"({time.perf_counter() - t0:.1f} s)")  # fmt: skip
+    traced = []
+    for c, b in starts:
+        if len(starts) > 1:
+            say(f"effects on {b.extra.get('structure', f'start {len(traced) + 1}')}")
+        traced.append(_trace_effects(family, c, b, max_effects, say))
+    best = min(range(len(traced)), key=lambda k: traced[k].current.heldout_error)
+    outcomes = [(c, t.base, t.current) for (c, _), t in zip(starts, traced, strict=True)]
+    family.chose_start(starts[best][0], outcomes, best, say)
+    ctx, trace = starts[best][0], traced[best]
+    base, current, effects = trace.base, trace.current, trace.effects
+    rounds, path = trace.rounds, trace.path
 
     report = family.finish(ctx, base, current, say)
     final_params = report.pop("effect_parameters", None) or {}

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -311,6 +311,26 @@ class ModelFamily(ABC):
     @abstractmethod
     def fit_base(self, ctx: Any, say: Callable[[str], None]) -> Candidate:
         """The base model fitted on the training part, scored on the held-out part."""
+
+    def fit_bases(self, ctx: Any, say: Callable[[str], None]) -> list[tuple[Any, Candidate]]:
+        """The base models the loop starts from, each with its context, best first: by
+        default :meth:`fit_base` alone. A family that chooses its structure may start the loop
+        from several (a flexible structure can take up an effect the catalogue names); the
+        engine keeps the one whose final model predicts the held-out part best
+        (:meth:`chose_start`)."""
+        return [(ctx, self.fit_base(ctx, say))]
+
+    def chose_start(
+        self,
+        ctx: Any,
+        outcomes: Sequence[tuple[Any, Candidate, Candidate]],
+        chosen: int,
+        say: Callable[[str], None],
+    ) -> None:
+        """Told which of several starts (``(ctx, base, final)`` per start of
+        :meth:`fit_bases`) the engine kept: ``outcomes[chosen]``, whose ``ctx`` is ``ctx``.
+        By default nothing is kept."""
+        return None
 
     def candidates(self, current: Candidate) -> Iterable[str]:
         """Catalogue effects that can still be added to ``current``."""
