@@ -37,6 +37,9 @@ taken out (:func:`effect_removed`, from the truth): its base model's held-out he
 what the structures the loop chooses from make of the effect named exactly, and the seeds
 where that is at most half the error before are counted (*halving within reach*). It is not a
 strict bound: another effect can predict the held-out runs better than the true one does.
+That identification costs about as much as the loop's; ``--removed-from REPORT`` takes its
+results from an earlier report of the same records and model instead (it has no effects to
+trace, so only a change of the base structures' fits changes it).
 
 With ``--simulator shipmmg`` the motions come from ShipMMG instead (:func:`shipmmg_runs`; no
 wind: ShipMMG has no wind loads), a cross-check that the counts are not an artefact of
@@ -50,6 +53,7 @@ Writes ``OUT/mmg_records.json``, ``OUT/mmg_records.png`` and the block between
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 import time
@@ -219,9 +223,10 @@ def shipmmg_runs(effect: str | None, seed: int, n_runs: int) -> list[Record]:
     return out
 
 
-def _case(task: tuple[str | None, int, str, int, str]) -> dict[str, Any]:
-    """Generate one effect and seed and identify it (a process-pool task)."""
-    effect, seed, model, n_runs, simulator = task
+def _case(task: tuple[str | None, int, str, int, str, float | None]) -> dict[str, Any]:
+    """Generate one effect and seed and identify it (a process-pool task); ``removed``: the
+    held-out heading RMS with the effect taken out, from an earlier report (None: fit it)."""
+    effect, seed, model, n_runs, simulator, removed = task
     row: dict[str, Any] = {"effect": effect or CLEAN, "seed": seed}
     t0 = time.perf_counter()
     if simulator == "shipmmg":
@@ -252,10 +257,11 @@ def _case(task: tuple[str | None, int, str, int, str]) -> dict[str, Any]:
     }
     if effect in REMOVABLE:  # the same structures with the effect named exactly
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                bound = identify(effect_removed(runs), model, max_effects=0)
-            removed = _psi(bound.heldout.get("error_before"))
+            if removed is None:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    bound = identify(effect_removed(runs), model, max_effects=0)
+                removed = _psi(bound.heldout.get("error_before"))
         except (ValueError, RuntimeError, np.linalg.LinAlgError):
             removed = math.nan
         row["removed_psi_deg"] = removed
@@ -426,6 +432,25 @@ def plot(doc: dict[str, Any], path: Path) -> None:
     plt.close(fig)
 
 
+def _earlier_removed(
+    ap: argparse.ArgumentParser, args: argparse.Namespace, model: str
+) -> dict[tuple[str, int], float]:
+    """``(effect, seed) -> removed_psi_deg`` of the report ``--removed-from`` (empty without
+    it); refused, naming the difference, for a report of other records or another model."""
+    if args.removed_from is None:
+        return {}
+    try:
+        doc = json.loads(Path(args.removed_from).read_text(encoding="utf-8"))
+        same = {k: doc[k] for k in ("model", "simulator", "n_runs")}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        ap.error(f"--removed-from {args.removed_from}: not an mmg_records report ({exc})")
+    mine = {"model": model, "simulator": args.simulator, "n_runs": args.n_runs}
+    if same != mine:
+        ap.error(f"--removed-from {args.removed_from}: a report of {same}, expected {mine}")
+    return {(r["effect"], r["seed"]): float(r["removed_psi_deg"]) for r in doc["rows"]
+            if isinstance(r.get("removed_psi_deg"), int | float)}  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default=DEFAULT_MODEL, help=f"model (default {DEFAULT_MODEL})")
@@ -445,6 +470,9 @@ def main(argv: list[str] | None = None) -> int:
         help="documentation page whose block to update",
     )
     ap.add_argument("--no-page", action="store_true", help="do not touch the page")
+    ap.add_argument("--removed-from", metavar="REPORT", default=None,
+                    help="take the error with the effect taken out from this earlier "
+                    "mmg_records JSON report of the same records and model")  # fmt: skip
     args = ap.parse_args(argv)
     if args.seeds < 1:
         ap.error(f"--seeds must be >= 1, got {args.seeds}")
@@ -470,7 +498,9 @@ def main(argv: list[str] | None = None) -> int:
         model = FALLBACK_MODEL
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    tasks = [(None if e == CLEAN else e, seed, model, args.n_runs, args.simulator)
+    earlier = _earlier_removed(ap, args, model)
+    tasks = [(None if e == CLEAN else e, seed, model, args.n_runs, args.simulator,
+              earlier.get((e, seed)))
              for e in args.effects for seed in range(args.seeds)]  # fmt: skip
     _say(f"{len(tasks)} identifications with {model} on {args.jobs} processes ...")
     t0 = time.perf_counter()
