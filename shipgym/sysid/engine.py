@@ -265,7 +265,6 @@ def _record_consistency(
     return out
 
 
-@threadpool_limits.wrap(limits=1, user_api="blas")  # the fits run side by side (pyproject)
 @dataclass
 class _Trace:
     """One run of the loop from a base model: the accepted effects and every round's scores."""
@@ -350,6 +349,7 @@ def _trace_effects(
     return _Trace(base, current, effects, rounds, path)
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # the fits run side by side (pyproject)
 def identify(
     record: Record | Sequence[Record],
     model: str | ModelFamily = "nomoto1",
