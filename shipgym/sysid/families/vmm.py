@@ -1810,8 +1810,8 @@ class VMMAutoFamily(VMMFamily):
     better (0.63 deg, the lag at 1.38 s against a true 1.38 s): chosen before the effects, the
     larger set kept most of the lag in its coefficients, and the lag, once named, took off
     less than half of the error. The smaller structure is the one traced too: a larger one
-    takes up more, and costs more (on the 13 HSVA runs the loop on the 60-term set took 121 s,
-    on ``martin_simple``, the winner there and the smallest judged, 36 s).
+    takes up more, and costs more (on the 13 HSVA runs the loop on the 60-term set took 3.4
+    times as long as on ``martin_simple``, the winner there and the smallest judged).
 
     Why every structure, and why a screen: the refined ranking of the symmetric sets says
     little about which set takes the asymmetry best. With only the best symmetric set tried
