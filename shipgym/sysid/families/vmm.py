@@ -1769,8 +1769,9 @@ def describe_selection(selection: Mapping[str, Any]) -> str:
     def named(n: str) -> str:
         return f"{n} with {', '.join(effects[n])}" if effects.get(n) else n
 
-    margin = f", {100 * (1 - final[best] / final[runner]):.0f} % below {named(runner)}" if (
-        runner) else ""  # fmt: skip
+    margin = ""
+    if runner:
+        margin = f", {100 * (1 - final[best] / final[runner]):.0f} % below {named(runner)}"
     alone = selection["heldout_error"]
     first = min(alone, key=alone.__getitem__)
     before = (f"; before any effect {first} predicted best, {alone[first]:.4g} against "
