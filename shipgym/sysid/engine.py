@@ -462,7 +462,7 @@ def identify(
         traced.append(_trace_effects(family, c, b, max_effects, say))
     best = min(range(len(traced)), key=lambda k: traced[k].current.heldout_error)
     outcomes = [(c, t.base, t.current) for (c, _), t in zip(starts, traced, strict=True)]
-    family.chose_start(starts[best][0], outcomes, best, say)
+    family.chose_start(outcomes, best, say)
     ctx, trace = starts[best][0], traced[best]
     base, current, effects = trace.base, trace.current, trace.effects
     rounds, path = trace.rounds, trace.path

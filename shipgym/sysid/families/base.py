@@ -322,14 +322,12 @@ class ModelFamily(ABC):
 
     def chose_start(
         self,
-        ctx: Any,
         outcomes: Sequence[tuple[Any, Candidate, Candidate]],
         chosen: int,
         say: Callable[[str], None],
     ) -> None:
         """Told which of several starts (``(ctx, base, final)`` per start of
-        :meth:`fit_bases`) the engine kept: ``outcomes[chosen]``, whose ``ctx`` is ``ctx``.
-        By default nothing is kept."""
+        :meth:`fit_bases`) the engine kept: ``outcomes[chosen]``. By default nothing is kept."""
         return None
 
     def candidates(self, current: Candidate) -> Iterable[str]:

@@ -1902,17 +1902,20 @@ class VMMAutoFamily(VMMFamily):
         return starts
 
     def fit_base(self, ctx: _Context, say: Callable[[str], None]) -> Candidate:
-        return self.fit_bases(ctx, say)[0][1]
+        """The best judged structure's base (``ctx`` takes its term set)."""
+        best, cand = self.fit_bases(ctx, say)[0]
+        ctx.term_set = best.term_set
+        return cand
 
     def chose_start(
         self,
-        ctx: _Context,
         outcomes: Sequence[tuple[_Context, Candidate, Candidate]],
         chosen: int,
         say: Callable[[str], None],
     ) -> None:
         """Keeps the structure whose final model (after the loop's effects) predicts best, and
         every start's outcome, in ``ctx.selection`` (``final_error``, ``final_effects``)."""
+        ctx = outcomes[chosen][0]
         finals = {c.term_set: final for c, _, final in outcomes}
         ctx.selection |= {
             "final_error": {n: f.heldout_error for n, f in finals.items()},
