@@ -236,7 +236,9 @@ class BusyCores:
         if self._stop is not None:
             self._stop.set()
         for p in self._procs:
-            p.join(timeout=5)
+            # a helper still importing its module (spawn: seconds on loaded cores) stops at its
+            # first poll once it runs
+            p.join(timeout=60)
             if p.is_alive():  # pragma: no cover - a helper that ignores the event
                 p.terminate()
         self._procs = []

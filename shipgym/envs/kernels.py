@@ -50,10 +50,10 @@ from shipgym.models.integrate import (
     RVG3DOF,
     STATE_COUNTS,
     block_work,
-    full_block_by_model,
-    full_block_rvg,
     gather_rows,
+    rk4_block,
     rk4_block_of,
+    rk4_block_rvg,
     scatter_rows,
 )
 from shipgym.models.rvg import P_TBOLL
@@ -123,12 +123,12 @@ def _map_and_gather(x, u, c, a, u0, B, steps, rows, start, n, work, nx, nu, na):
 
 
 @row_kernel
-def _advance_block(full_block, model_id, x, u, p, c, dt, a, u0, B, steps, rows, start, n, work, na):
-    """:func:`_map_and_gather`, one RK4 step of the block
-    (:func:`~shipgym.models.integrate.rk4_block_of`) and the states copied back, for a
+def _advance_block(x, u, p, c, dt, a, u0, B, steps, rows, start, n, work, na):
+    """:func:`_map_and_gather`, one RK4 step of the block by the Gunnerus's own RK4
+    (:func:`~shipgym.models.integrate.rk4_block_rvg`) and the states copied back, for a
     Gunnerus task with ``na`` actions."""
     _map_and_gather(x, u, c, a, u0, B, steps, rows, start, n, work, NX_RVG, NU_RVG, na)
-    rk4_block_of(full_block, model_id, work[0], work[1], p, work[2], dt, n, work[3])
+    rk4_block_of(rk4_block_rvg, RVG3DOF, work[0], work[1], p, work[2], dt, n, work[3])
     scatter_rows(work[0], rows, start, n, x, NX_RVG)
 
 
@@ -259,7 +259,7 @@ def _heading(
             else:
                 _map_and_gather(x, u, c, a, u0, B, steps, rows, start, m, work,
                                 dims[0], dims[1], dims[2])  # fmt: skip
-            rk4_block_of(full_block_by_model, model_id, work[0], work[1], p, work[2], dt, m,
+            rk4_block_of(rk4_block, model_id, work[0], work[1], p, work[2], dt, m,
                          work[3])  # fmt: skip
             if family == 0:
                 scatter_rows(work[0], rows, start, m, x, FIRST_ORDER[0])
@@ -350,9 +350,7 @@ def _speed(
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
-            _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
-            )
+            _advance_block(x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na)
         _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
@@ -459,9 +457,7 @@ def _path(
             k = seg[i]
             s_before[b] = on_leg(x, i, k, tangent, leg_length)[1]
         if advance:
-            _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
-            )
+            _advance_block(x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na)
         _seaway(sw, rows, start, m, x, c, xm, dt, advance)
         _begin_block(x, a, rows, start, m, ok, cost, rew, term, reason, NX_RVG, na)
         for b in range(m):
@@ -559,9 +555,7 @@ def _target(
     for start in range(0, n_rows, BLOCK):
         m = min(BLOCK, n_rows - start)
         if advance:
-            _advance_block(
-                full_block_rvg, RVG3DOF, x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na
-            )
+            _advance_block(x, u, p, c, dt, a, u0, B, steps, rows, start, m, work, na)
             for b in range(m):
                 i = rows[start + b]
                 target[i, 0] += target_vel[i, 0] * dt

@@ -28,9 +28,8 @@ identification's replays hold their ship as a ``(nx, 1)`` block), so every user 
 runs the same function and a ship's result does not depend on the batch it is in. A batch
 held as rows (the envs, :func:`rk4_step_kernel`) is stepped block by block: gathered into a
 block (:func:`gather_rows`), stepped (:func:`rk4_block_of`: a full block and a block of one with
-their width as a compile-time constant and, in the env kernels, a full block by each model's own
-copy of the step with its number of states known too: :func:`full_block_by_model`,
-:func:`full_block_rvg`) and scattered back (:func:`scatter_rows`); :func:`rk4_rows` does all
+their width as a compile-time constant; the Gunnerus tasks by :func:`rk4_block_rvg`, which holds
+no other model's code) and scattered back (:func:`scatter_rows`); :func:`rk4_rows` does all
 three. The model-test models (MMG,
 VMM), which no environment uses, keep their per-ship functions and :func:`rk4_stages`.
 
@@ -184,38 +183,14 @@ def rk4_block(model_id, X, U, p, C, h, n, W):
     _rk4(block_rhs, model_id, X.shape[0], X, U, p, C, h, n, W)
 
 
-# The RK4 step of a full block of BLOCK ships (rk4_block_of's first argument): the block's
-# width is a compile-time constant in all three, the number of states too in the per-model ones.
-_NX_FIRST, _NX_SECOND, _NX_RVG = STATE_COUNTS[NOMOTO1], STATE_COUNTS[NOMOTO2], STATE_COUNTS[RVG3DOF]
+_NX_RVG = STATE_COUNTS[RVG3DOF]
 
 
 @row_kernel
-def full_block_any(model_id, X, U, p, C, h, W):
-    """:func:`rk4_block` of a full block: one RK4 for every model (the least code)."""
-    rk4_block(model_id, X, U, p, C, h, BLOCK, W)
-
-
-@row_kernel
-def full_block_by_model(model_id, X, U, p, C, h, W):
-    """:func:`rk4_block` of a full block, each model's step a copy of its own with its number
-    of states known: the loops have known trip counts (the first-order Nomoto model's step
-    1.55 x faster than :func:`full_block_any`'s, the RVG's 1.13 x; more code to compile)."""
-    if model_id == NOMOTO1:
-        _rk4(_cols, nomoto1_col, _NX_FIRST, X, U, p, C, h, BLOCK, W)
-    elif model_id == NOMOTO2:
-        _rk4(_cols, nomoto2_col, _NX_SECOND, X, U, p, C, h, BLOCK, W)
-    elif model_id == NORRBIN:
-        _rk4(_cols, norrbin_col, _NX_FIRST, X, U, p, C, h, BLOCK, W)
-    elif model_id == BECH:
-        _rk4(_cols, bech_col, _NX_SECOND, X, U, p, C, h, BLOCK, W)
-    else:
-        _rk4(_rvg_cols, rvg_col, _NX_RVG, X, U, p, C, h, BLOCK, W)
-
-
-@row_kernel
-def full_block_rvg(model_id, X, U, p, C, h, W):
-    """:func:`full_block_by_model` of the R/V Gunnerus alone (no other model's code)."""
-    _rk4(_rvg_cols, rvg_col, _NX_RVG, X, U, p, C, h, BLOCK, W)
+def rk4_block_rvg(model_id, X, U, p, C, h, n, W):
+    """:func:`rk4_block` of the R/V Gunnerus alone: no other model's code to compile, and its
+    number of states a compile-time constant (``model_id`` is not read)."""
+    _rk4(_rvg_cols, rvg_col, _NX_RVG, X, U, p, C, h, n, W)
 
 
 @row_kernel
@@ -284,35 +259,34 @@ def scatter_rows(XB, rows, start, n, x, nx):
 
 
 @row_kernel
-def rk4_block_of(full_block, model_id, X, U, p, C, h, n, W):
-    """:func:`rk4_block` of ships ``range(n)`` of a block, a full block by ``full_block``
-    (:func:`full_block_any`, :func:`full_block_by_model` or :func:`full_block_rvg`; the same
-    numbers, more or less code).
+def rk4_block_of(step, model_id, X, U, p, C, h, n, W):
+    """One RK4 step of ships ``range(n)`` of a block by ``step`` (:func:`rk4_block`, or
+    :func:`rk4_block_rvg` where the ship is the R/V Gunnerus), with the width of a full block
+    and of a block of one as compile-time constants.
 
-    A full block is stepped with its width :data:`BLOCK` as a compile-time constant: the loops
-    over its ships then have a known trip count, with no remainder loops and no run-time checks
-    at every loop (1.2 x faster for the RVG, 1.8 x for a Nomoto model, than the same step with
-    the width known at run time only, which the last, partial block of a batch keeps). So is a
-    block of one ship (the single env's step): a loop whose width is known at run time only
-    costs about 60 ns to set up, more than one ship's derivative.
+    A full block of :data:`BLOCK` ships is stepped with a known trip count: no remainder loops
+    and no run-time checks at every loop (1.2 x faster for the RVG, 1.8 x for a Nomoto model,
+    than the same step with the width known at run time only, which the last, partial block of
+    a batch keeps). So is a block of one ship (the single env's step): a loop whose width is
+    known at run time only costs about 60 ns to set up, more than one ship's derivative.
     """
     if n == BLOCK:
-        full_block(model_id, X, U, p, C, h, W)
+        step(model_id, X, U, p, C, h, BLOCK, W)
     elif n == 1:
-        rk4_block(model_id, X, U, p, C, h, 1, W)
+        step(model_id, X, U, p, C, h, 1, W)
     else:
-        rk4_block(model_id, X, U, p, C, h, n, W)
+        step(model_id, X, U, p, C, h, n, W)
 
 
 @row_kernel
-def rk4_rows(full_block, model_id, x, u, p, c, h, rows, start, n, work):
+def rk4_rows(step, model_id, x, u, p, c, h, rows, start, n, work):
     """One RK4 step of ships ``rows[start:start + n]`` of a batch (ships as rows): copied
     into the block work arrays ``work`` (:func:`block_work`), stepped by :func:`rk4_block_of`
     and copied back."""
     XB, UB, CB, W = work
     nx, nu = x.shape[1], u.shape[1]
     gather_rows(x, u, c, rows, start, n, XB, UB, CB, nx, nu)
-    rk4_block_of(full_block, model_id, XB, UB, p, CB, h, n, W)
+    rk4_block_of(step, model_id, XB, UB, p, CB, h, n, W)
     scatter_rows(XB, rows, start, n, x, nx)
 
 
@@ -380,7 +354,7 @@ def rk4_step_kernel(model_id, x, u, p, c, h):
         work = block_work(x.shape[1], u.shape[1], n)
         for start in range(0, n, BLOCK):
             m = min(BLOCK, n - start)
-            rk4_rows(full_block_any, model_id, x, u, p, c, h, rows, start, m, work)
+            rk4_rows(rk4_block, model_id, x, u, p, c, h, rows, start, m, work)
     else:
         work = np.empty((5, x.shape[1]))
         k1, k2, k3, k4, t = work[0], work[1], work[2], work[3], work[4]

@@ -14,7 +14,7 @@ into consecutive windows of ``window_s`` seconds (:data:`RVG_WINDOW_S`); each wi
 the measured hull state ``x, y, psi, u, v, r`` (``v = 0`` if not recorded; read off a local fit
 over :data:`START_SMOOTHING_S` around the start, not one noisy sample); the pods' thrust and
 azimuth are not measured, so they run on through the windows from the first orders, and each
-window is simulated by :func:`shipgym.models.integrate.rk4_block` with the record's sample steps
+window is simulated by :func:`shipgym.models.integrate.rk4_block_rvg` with the record's sample steps
 (:func:`replay_windows`, :func:`simulate_orders` for one free run).
 
 An order logged at one sample changed somewhere in the step before it, at its midpoint on
@@ -121,7 +121,7 @@ from scipy.signal import savgol_filter
 
 from shipgym.models import RVGParams
 from shipgym.models._jit import kernel, row_kernel
-from shipgym.models.integrate import RVG3DOF, disturbance_block, rk4_block
+from shipgym.models.integrate import RVG3DOF, disturbance_block, rk4_block_rvg
 from shipgym.models.model_file import rvg_document
 from shipgym.models.rvg import (
     AZIMUTH_TIME_CONSTANT_RANGE,
@@ -463,7 +463,7 @@ def _windows(width, t, meas, rpm, az, starts, P, C, alpha0, v0, out):  # pragma:
                     u[0, b], u[1, b] = pod_thrusts_col(rpm[j], x, C, P, b)
                     u[2, b] = az[j] + alpha0[b]
                     u[3, b] = az[j] + alpha0[b]
-                rk4_block(RVG3DOF, x, u, P, C, h, width, work)
+                rk4_block_rvg(RVG3DOF, x, u, P, C, h, width, work)
             for b in range(width):
                 for j in range(10):
                     out[k + 1, b, j] = x[j, b]
