@@ -169,15 +169,17 @@ def cold_parts(parts: Sequence[str] = tuple(PARTS)) -> list[str]:
 #: measured 2026-11-27 (Numba 0.68.1). A kernel already in the cache is loaded, not compiled:
 #: in :data:`PARALLEL_GROUPS` ``models`` took 0.5 s (the parts before it or ``sysid`` beside it
 #: had compiled what it needs), so the estimate of those groups is high by about 20 s.
-#: ``heading`` is 35 s scaled by 0.875, its kernel's compile time without the per-model copies
-#: of the RK4 step over that with them (65.9 / 75.3 s side by side, 2026-11-28).
+#: ``heading`` and ``sysid`` are scaled by the ratio of their compile times after a change to
+#: before it, side by side (2026-11-28): ``heading`` 35 s x 0.875 without the per-model copies
+#: of the RK4 step (65.9 / 75.3 s), ``sysid`` 49 s x 0.86 with the Nomoto replays compiling
+#: their own model alone (144 / 167 s).
 COLD_COMPILE_S: dict[str, float] = {
     "heading": 30.5,
     "speed": 16.5,
     "path_following": 18.0,
     "target_tracking": 17.0,
     "models": 21.0,
-    "sysid": 49.0,
+    "sysid": 42.0,
 }
 
 #: The parts split in processes of about equal compile time.

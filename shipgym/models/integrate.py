@@ -183,6 +183,14 @@ def rk4_block(model_id, X, U, p, C, h, n, W):
     _rk4(block_rhs, model_id, X.shape[0], X, U, p, C, h, n, W)
 
 
+@row_kernel
+def rk4_block_nomoto(col, X, U, p, C, h, n, W):
+    """:func:`rk4_block` of one Nomoto-family model, given by its per-ship function ``col``
+    (``nomoto1_col``, ``nomoto2_col``, ``norrbin_col``, ``bech_col``): no other model's code to
+    compile (the identification's replays, which fit one model at a time)."""
+    _rk4(_cols, col, X.shape[0], X, U, p, C, h, n, W)
+
+
 _NX_RVG = STATE_COUNTS[RVG3DOF]
 
 

@@ -89,9 +89,21 @@ from shipgym.models import (
 )
 from shipgym.models._jit import kernel, row_kernel
 from shipgym.models.base import MODEL_NAMES
-from shipgym.models.integrate import BECH, NC, NOMOTO1, NOMOTO2, NORRBIN, rk4_block
+from shipgym.models.integrate import BECH, NC, NOMOTO1, NOMOTO2, NORRBIN, rk4_block_nomoto
 from shipgym.models.model_file import with_rudder_offset
-from shipgym.models.nomoto import IDELTA, IPSI, IR, IRDOT, IU, P_YAW, pack_nomoto
+from shipgym.models.nomoto import (
+    IDELTA,
+    IPSI,
+    IR,
+    IRDOT,
+    IU,
+    P_YAW,
+    bech_col,
+    nomoto1_col,
+    nomoto2_col,
+    norrbin_col,
+    pack_nomoto,
+)
 from shipgym.sysid.batched import SideBySide, lanes
 
 __all__ = [
@@ -412,7 +424,7 @@ class FitResult:
 
 
 @row_kernel
-def _replay_loop(model_id, width, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
+def _replay_loop(col, width, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
     nx = X0.shape[0]
     x = np.empty((nx, width))  # the variants as a block of ships (states x ships)
     u = np.zeros((2, width))
@@ -429,44 +441,44 @@ def _replay_loop(model_id, width, X0, delta, d0, speed, n_cmd, h, P, out):  # pr
             x[IU, b] = speed[k]
             u[0, b] = dl + _REPLAY_TC * ((delta[k + 1] + d0[b]) - dl) / h[k]
             u[1, b] = n_cmd[k]
-        rk4_block(model_id, x, u, P, c, h[k], width, work)
+        rk4_block_nomoto(col, x, u, P, c, h[k], width, work)
         for b in range(width):
             for j in range(nx):
                 out[k + 1, b, j] = x[j, b]
 
 
 @row_kernel
-def _replay_variants(model_id, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
+def _replay_variants(col, X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover
     """One variant as a block of one (its width a compile-time constant), several as one
     block whose loops over the variants compile to SIMD code."""
     if P.shape[1] == 1:
-        _replay_loop(model_id, 1, X0, delta, d0, speed, n_cmd, h, P, out)
+        _replay_loop(col, 1, X0, delta, d0, speed, n_cmd, h, P, out)
     else:
-        _replay_loop(model_id, P.shape[1], X0, delta, d0, speed, n_cmd, h, P, out)
+        _replay_loop(col, P.shape[1], X0, delta, d0, speed, n_cmd, h, P, out)
 
 
-# One compilation of the loop per model: with the model id a compile-time constant the model
-# dispatch of ``rk4_block`` folds away, which makes the replay about three times faster than
-# with the id as a run-time argument (same arithmetic, identical results). Each is compiled
-# on first use.
+# One compilation of the loop per model, with that model's code alone
+# (:func:`~shipgym.models.integrate.rk4_block_nomoto`): about three times faster than the
+# replay with the model id as a run-time argument (same arithmetic, identical results), and
+# no other model's code to compile. Each is compiled on first use.
 @kernel
 def _replay_nomoto1(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
-    _replay_variants(NOMOTO1, X0, delta, d0, speed, n_cmd, h, P, out)
+    _replay_variants(nomoto1_col, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
 def _replay_nomoto2(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
-    _replay_variants(NOMOTO2, X0, delta, d0, speed, n_cmd, h, P, out)
+    _replay_variants(nomoto2_col, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
 def _replay_norrbin(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
-    _replay_variants(NORRBIN, X0, delta, d0, speed, n_cmd, h, P, out)
+    _replay_variants(norrbin_col, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 @kernel
 def _replay_bech(X0, delta, d0, speed, n_cmd, h, P, out):  # pragma: no cover - jit
-    _replay_variants(BECH, X0, delta, d0, speed, n_cmd, h, P, out)
+    _replay_variants(bech_col, X0, delta, d0, speed, n_cmd, h, P, out)
 
 
 _REPLAY_KERNELS = {
@@ -494,7 +506,7 @@ def _replay_kernel(
 
     At step ``k`` the rudder and speed states are set to ``delta[k] + d0``, ``speed[k]`` and
     the commands to the rudder's first-order lead ``dc`` and ``n_cmd[k]`` (module docstring),
-    then one RK4 step of ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_block`, all
+    then one RK4 step of ``h[k]`` is taken by :func:`shipgym.models.integrate.rk4_block_nomoto`, all
     the variants as the ships of one block (padded to whole SIMD vectors,
     :func:`shipgym.sysid.batched.lanes`).
     """

@@ -43,8 +43,8 @@ import numpy as np
 
 from shipgym.models import Nomoto1Params, SteeringGear, make_model
 from shipgym.models._jit import kernel
-from shipgym.models.integrate import NC, NOMOTO1, rk4_block
-from shipgym.models.nomoto import IDELTA
+from shipgym.models.integrate import NC, rk4_block_nomoto
+from shipgym.models.nomoto import IDELTA, nomoto1_col
 from shipgym.sysid.data import Record
 
 __all__ = [
@@ -616,7 +616,7 @@ def jsonable(obj: Any) -> Any:
 def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
     """:meth:`ShipModel.simulate` of a ``nomoto1`` model with inputs ``(cmd[k], 0)``, compiled.
 
-    The same RK4 steps (:func:`shipgym.models.integrate.rk4_block`, no current); writes the
+    The same RK4 steps (:func:`shipgym.models.integrate.rk4_block_nomoto`, no current); writes the
     rudder state ``x[IDELTA]`` at every step into ``out`` (length ``cmd.size + 1``).
     """
     nx = x0.shape[0]
@@ -629,7 +629,7 @@ def _gear_kernel(x0, cmd, p, h, out):  # pragma: no cover - jit
     out[0] = x[IDELTA, 0]
     for k in range(cmd.shape[0]):
         u[0, 0] = cmd[k]
-        rk4_block(NOMOTO1, x, u, p, c, h, 1, work)
+        rk4_block_nomoto(nomoto1_col, x, u, p, c, h, 1, work)
         out[k + 1] = x[IDELTA, 0]
 
 
