@@ -240,11 +240,17 @@ def _case(task: tuple[str | None, int, str, int, str, float | None]) -> dict[str
     except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
         return row | {"error": f"{type(exc).__name__}: {exc}", "runtime_s": 0.0}
     named = res.effect_names
+    sel = res.diagnostics.get("term_set_selection") or {}
     before, after = _psi(res.heldout.get("error_before")), _psi(res.heldout.get("error_after"))
     row |= {
         "named": named,
         "first": named[0] if named else None,
-        "structure": (res.diagnostics.get("term_set_selection") or {}).get("chosen"),
+        "structure": sel.get("chosen"),
+        # the structures the loop ran on: each one's final held-out error and effects
+        "structures": {
+            n: {"heldout_error": e, "effects": sel.get("final_effects", {}).get(n, [])}
+            for n, e in sel.get("final_error", {}).items()
+        },
         "heldout_runs": res.heldout.get("runs", []),
         "footprint_psi_deg": footprint(effect, seed, n_runs, res.heldout.get("runs", [])),
         "heldout_psi_before_deg": before,

@@ -482,6 +482,7 @@ def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     from shipgym.sysid.families.vmm import (
         STRUCTURE_EFFECTS,
         VMMAutoFamily,
+        larger_structure_drop,
         loop_terms,
         term_set_terms,
     )
@@ -499,8 +500,12 @@ def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     smaller = [n for n in judged if len(term_set_terms(n)) < len(term_set_terms(judged[0]))]
     assert list(sel["final_error"]) == [judged[0], *smaller[:1]]  # the structures traced
     assert len(sel["final_error"]) == 1 or all(f"effects on {n}" in said for n in smaller[:1])
-    finals = sel["final_error"]
-    assert sel["chosen"] == min(finals, key=finals.__getitem__)
+    finals, terms = sel["final_error"], sel["final_terms"]
+    assert terms == {n: len(term_set_terms(n)) for n in finals}
+    fewest = min(finals, key=terms.__getitem__)
+    need = {n: larger_structure_drop(terms[n] - terms[fewest]) for n in finals}
+    beats = [n for n in finals if n != fewest and finals[n] < (1 - need[n]) * finals[fewest]]
+    assert sel["chosen"] == (beats[0] if beats else fewest)
     assert sel["final_effects"][sel["chosen"]] == result.effect_names
     # the reported path starts from the chosen structure's base
     first = list(result.heldout["path"][0]["heldout_rms"].values())
@@ -513,6 +518,60 @@ def test_vmm_auto_chooses_the_term_set_by_held_out_error_and_says_so() -> None:
     assert "+" not in sel["chosen"] and f"{sel['chosen']}+turn_asymmetry" in scores
     assert "turn_asymmetry" not in result.rounds[0]
     assert {"asymmetry", "rudder_offset", "current"} <= set(result.rounds[0])
+
+
+@pytest.mark.parametrize(
+    ("larger", "smaller", "kept"),
+    [("abkowitz+turn_asymmetry", 0.90, "mmg_hull+turn_asymmetry"),
+     ("abkowitz+turn_asymmetry", 0.84, "abkowitz+turn_asymmetry"),
+     ("mmg_hull", 0.96, "norrbin3"), ("mmg_hull", 0.95, "mmg_hull")],
+)  # fmt: skip
+def test_more_terms_are_kept_only_when_each_extra_term_buys_its_share_of_the_error(
+    larger: str, smaller: float, kept: str
+) -> None:
+    """Of the structures the loop ran on, the one with fewer terms is kept unless the other's
+    final model predicts the held-out runs better by 0.5 % per extra term, at most the 15 % an
+    effect must clear: the 68-term Abkowitz set 10 % better than the 36-term ``mmg_hull`` with
+    the turn asymmetry loses, 16 % better wins; ``mmg_hull`` 4 % better than ``norrbin3`` (9
+    fewer terms, 4.5 % asked) loses, 5 % better wins."""
+    from types import SimpleNamespace
+
+    from shipgym.sysid.families.vmm import (
+        DROP_PER_EXTRA_TERM,
+        VMM_MIN_RELATIVE_DROP,
+        VMMAutoFamily,
+        larger_structure_drop,
+        term_set_terms,
+    )
+
+    assert (DROP_PER_EXTRA_TERM, VMM_MIN_RELATIVE_DROP) == (0.005, 0.15)
+    assert larger_structure_drop(32) == 0.15 and larger_structure_drop(9) == pytest.approx(0.045)
+    fewer = {"abkowitz+turn_asymmetry": "mmg_hull+turn_asymmetry", "mmg_hull": "norrbin3"}[larger]
+    extra = len(term_set_terms(larger)) - len(term_set_terms(fewer))
+    assert extra == {"mmg_hull": 9, "abkowitz+turn_asymmetry": 32}[larger]
+    judged = {larger: 0.7, fewer: 0.9}
+    outcomes = []
+    for name, error in ((larger, smaller), (fewer, 1.0)):
+        ctx = SimpleNamespace(term_set=name, selection={"heldout_error": judged})
+        final = SimpleNamespace(heldout_error=error, effects=("rudder_offset",))
+        outcomes.append((ctx, None, final))
+    said: list[str] = []
+    chosen = VMMAutoFamily().choose_start(outcomes, said.append)
+    assert outcomes[chosen][0].term_set == kept
+    sel = outcomes[chosen][0].selection
+    assert sel["chosen"] == kept and sel["final_error"] == {larger: smaller, fewer: 1.0}
+    if kept == fewer:
+        gain, need = 100 * (1 - smaller), 100 * larger_structure_drop(extra)
+        assert said == [
+            f"term set {fewer} with rudder_offset (the fewest terms; {larger} with rudder_offset "
+            f"predicts {gain:.1f} % better with {extra} more terms, less than the {need:.1f} % "
+            f"they must gain; before any effect {larger} predicted best, 0.7 against 0.9)"
+        ]
+    else:
+        assert said[0].startswith(
+            f"term set {larger} with rudder_offset (the lowest held-out error of the term sets, "
+            f"{100 * (1 - smaller):.0f} % below {fewer}"
+        )
 
 
 def test_when_every_regression_runs_away_vmm_auto_still_refines_some_structures(

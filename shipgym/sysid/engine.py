@@ -460,9 +460,8 @@ def identify(
         if len(starts) > 1:
             say(f"effects on {b.extra.get('structure', f'start {len(traced) + 1}')}")
         traced.append(_trace_effects(family, c, b, max_effects, say))
-    best = min(range(len(traced)), key=lambda k: traced[k].current.heldout_error)
     outcomes = [(c, t.base, t.current) for (c, _), t in zip(starts, traced, strict=True)]
-    family.chose_start(outcomes, best, say)
+    best = family.choose_start(outcomes, say)
     ctx, trace = starts[best][0], traced[best]
     base, current, effects = trace.base, trace.current, trace.effects
     rounds, path = trace.rounds, trace.path

@@ -315,20 +315,18 @@ class ModelFamily(ABC):
     def fit_bases(self, ctx: Any, say: Callable[[str], None]) -> list[tuple[Any, Candidate]]:
         """The base models the loop starts from, each with its context, best first: by
         default :meth:`fit_base` alone. A family that chooses its structure may start the loop
-        from several (a flexible structure can take up an effect the catalogue names); the
-        engine keeps the one whose final model predicts the held-out part best
-        (:meth:`chose_start`)."""
+        from several (a flexible structure can take up an effect the catalogue names); which
+        start's final model is kept is :meth:`choose_start`'s choice."""
         return [(ctx, self.fit_base(ctx, say))]
 
-    def chose_start(
+    def choose_start(
         self,
         outcomes: Sequence[tuple[Any, Candidate, Candidate]],
-        chosen: int,
         say: Callable[[str], None],
-    ) -> None:
-        """Told which of several starts (``(ctx, base, final)`` per start of
-        :meth:`fit_bases`) the engine kept: ``outcomes[chosen]``. By default nothing is kept."""
-        return None
+    ) -> int:
+        """Which of several starts (``(ctx, base, final)`` per start of :meth:`fit_bases`) to
+        keep: by default the one whose final model predicts the held-out part best."""
+        return min(range(len(outcomes)), key=lambda k: outcomes[k][2].heldout_error)
 
     def candidates(self, current: Candidate) -> Iterable[str]:
         """Catalogue effects that can still be added to ``current``."""

@@ -88,6 +88,7 @@ from shipgym.sysid.families.base import (
 
 __all__ = [
     "COLLINEAR_RCOND",
+    "DROP_PER_EXTRA_TERM",
     "FILTER_LENGTHS",
     "STRUCTURE_EFFECTS",
     "VMM_EFFECTS",
@@ -96,6 +97,7 @@ __all__ = [
     "VMMFit",
     "describe_selection",
     "kvlcc2_particulars",
+    "larger_structure_drop",
     "loop_terms",
     "prepare_runs",
     "refine",
@@ -136,6 +138,13 @@ START_PRIOR = 0.005
 
 VMM_MIN_RELATIVE_DROP = 0.15
 """Required relative drop of the held-out error (geometric mean of ``psi, r, u, v``)."""
+
+DROP_PER_EXTRA_TERM = 0.005
+"""Relative drop of the held-out error each term a structure has beyond another's must buy
+for ``vmm:auto`` to keep it (up to :data:`VMM_MIN_RELATIVE_DROP`): Akaike's criterion asks each
+parameter to lower the log of the error by one over the independent samples, and two held-out
+runs of a model-test zigzag hold about 200 (a minute and a half each, their errors correlated
+over about a second)."""
 
 _CHANNELS = ("psi", "r", "u", "v")
 _STATE_COL = {"x": 0, "y": 1, "psi": 2, "u": 3, "v": 4, "r": 5}
@@ -1758,6 +1767,13 @@ class MMGFamily(VMMFamily):
         return out
 
 
+def larger_structure_drop(extra_terms: int) -> float:
+    """Relative drop of the held-out error a structure with ``extra_terms`` more terms than
+    another must give to be kept over it: :data:`DROP_PER_EXTRA_TERM` per term, at most
+    :data:`VMM_MIN_RELATIVE_DROP`."""
+    return min(DROP_PER_EXTRA_TERM * extra_terms, VMM_MIN_RELATIVE_DROP)
+
+
 def describe_selection(selection: Mapping[str, Any]) -> str:
     """One line on ``vmm:auto``'s choice (``term_set_selection`` of its diagnostics): the
     structure whose final model predicted best, with its effects, the margin to the next, and
@@ -1769,14 +1785,21 @@ def describe_selection(selection: Mapping[str, Any]) -> str:
     def named(n: str) -> str:
         return f"{n} with {', '.join(effects[n])}" if effects.get(n) else n
 
-    margin = ""
-    if runner:
+    how, margin = "the lowest held-out error of the term sets", ""
+    if runner and final[best] <= final[runner]:
         margin = f", {100 * (1 - final[best] / final[runner]):.0f} % below {named(runner)}"
+    elif runner:
+        terms = selection["final_terms"]
+        extra = terms[runner] - terms[best]
+        how = "the fewest terms"
+        margin = (f"; {named(runner)} predicts {100 * (1 - final[runner] / final[best]):.1f} % "
+                  f"better with {extra} more terms, less than the "
+                  f"{100 * larger_structure_drop(extra):.1f} % they must gain")  # fmt: skip
     alone = selection["heldout_error"]
     first = min(alone, key=alone.__getitem__)
     before = (f"; before any effect {first} predicted best, {alone[first]:.4g} against "
               f"{alone[best]:.4g}") if first != best else ""  # fmt: skip
-    return f"{named(best)} (the lowest held-out error of the term sets{margin}{before})"
+    return f"{named(best)} ({how}{margin}{before})"
 
 
 class VMMAutoFamily(VMMFamily):
@@ -1794,8 +1817,9 @@ class VMMAutoFamily(VMMFamily):
        ``psi, r, u, v`` RMS);
     3. **with their effects**: the loop traces the effects on the best judged structure and
        on the best judged structure with fewer terms than it (:meth:`fit_bases`;
-       :attr:`LOOP_STRUCTURES` in all), and the structure whose final model predicts best
-       wins (:meth:`chose_start`).
+       :attr:`LOOP_STRUCTURES` in all); the one with fewer terms wins unless the other's final
+       model predicts the held-out runs better by a margin that grows with its extra terms
+       (:meth:`choose_start`).
 
     An effect of :data:`STRUCTURE_EFFECTS` whose structure was judged is not tried again in
     the loop's first round: a symmetric ship keeps a symmetric structure, an asymmetric one
@@ -1907,19 +1931,30 @@ class VMMAutoFamily(VMMFamily):
         ctx.term_set = best.term_set
         return cand
 
-    def chose_start(
+    def choose_start(
         self,
         outcomes: Sequence[tuple[_Context, Candidate, Candidate]],
-        chosen: int,
         say: Callable[[str], None],
-    ) -> None:
-        """Keeps the structure whose final model (after the loop's effects) predicts best, and
-        every start's outcome, in ``ctx.selection`` (``final_error``, ``final_effects``)."""
+    ) -> int:
+        """The structure whose final model (after the loop's effects) is kept: the one with the
+        fewest terms, unless one with more terms predicts the held-out runs better by
+        :data:`DROP_PER_EXTRA_TERM` for each extra term, up to :data:`VMM_MIN_RELATIVE_DROP`,
+        the margin an effect must clear to be added (:func:`larger_structure_drop`). Every
+        start's outcome goes into ``ctx.selection`` (``final_error``, ``final_effects``)."""
+        errors = [final.heldout_error for _, _, final in outcomes]
+        sizes = [len(term_set_terms(c.term_set)) for c, _, _ in outcomes]
+        by_size = sorted(range(len(outcomes)), key=sizes.__getitem__)
+        chosen = by_size[0]
+        for k in by_size[1:]:
+            need = larger_structure_drop(sizes[k] - sizes[chosen])
+            if errors[k] < (1.0 - need) * errors[chosen]:
+                chosen = k
         ctx = outcomes[chosen][0]
         finals = {c.term_set: final for c, _, final in outcomes}
         ctx.selection |= {
             "final_error": {n: f.heldout_error for n, f in finals.items()},
             "final_effects": {n: list(f.effects) for n, f in finals.items()},
+            "final_terms": {c.term_set: n for (c, _, _), n in zip(outcomes, sizes, strict=True)},
         }
         ranked = sorted(finals, key=lambda n: finals[n].heldout_error)
         ctx.selection["chosen"] = ctx.term_set
@@ -1928,6 +1963,7 @@ class VMMAutoFamily(VMMFamily):
             None,
         )
         say(f"term set {describe_selection(ctx.selection)}")
+        return chosen
 
     def finish(
         self, ctx: _Context, base: Candidate, final: Candidate, say: Callable[[str], None]
