@@ -120,7 +120,7 @@ def _identify_summary(result: Any, source: str) -> str:
 
     lines = [f"shipgym identify {source}", f"model: {result.model}"]
     selection = result.diagnostics.get("term_set_selection")
-    if selection:  # vmm:auto: the term set that predicted the held-out runs best
+    if selection:  # vmm:auto: the term set kept and why
         from shipgym.sysid.families.vmm import describe_selection
 
         lines.append(f"term set: {describe_selection(selection)}")
