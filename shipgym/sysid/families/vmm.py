@@ -1850,13 +1850,14 @@ class VMMAutoFamily(VMMFamily):
     every run diverges).
 
     Why fewer terms unless each extra term pays: with the final models compared by their
-    held-out error alone, on three of six MMG-made zero-error record sets the 68-term
-    ``abkowitz+turn_asymmetry`` with ``asymmetry`` (a side force and a moment growing with the
-    thrust) predicted about 10 % better than the 36-term ``mmg_hull+turn_asymmetry`` with the
-    true rudder zero error, and was kept; asking every extra term for a share of the error
-    names the zero error on all six. A flat 15 % instead kept ``norrbin3`` on MARIN's KVLCC2
-    (``mmg_hull``, 9 terms more, predicted 14.9 % better; held-out heading 5.24 deg against
-    4.31), so the margin grows with the terms.
+    held-out error alone, on three of six zero-error record sets of shipgym's MMG model the
+    68-term ``abkowitz+turn_asymmetry`` with ``asymmetry`` (a side force and a moment growing
+    with the thrust) predicted 8-14 % better than a smaller structure with the true rudder zero
+    error, and was kept; asking every extra term for a share of the error names the zero error
+    on all six. On ShipMMG's records it does not: there the smaller structure kept names
+    ``asymmetry`` itself (1 of 6 named, 3 before). A flat 15 % instead kept ``norrbin3`` on
+    MARIN's KVLCC2 (``mmg_hull``, 9 terms more, predicted 14.9 % better; held-out heading 5.24
+    deg against 4.31), so the margin grows with the terms.
 
     Every judged structure is refined in full before it is ranked: ranked after 6 of the 20
     cost evaluations instead (half the cost), the 60-term Abkowitz set, slower to converge,
