@@ -23,7 +23,8 @@ Loads
       of the NORSOK N-003 spectrum (``S(0) = 4 sigma^2 T``, both matched exactly)::
 
           sigma^2 = 320 (U_10 / 10)^2.75 I / 172,   T = 172 / (4 I) (U_10 / 10)^-0.75,
-          I = int_0^inf (1 + x^0.468)^(-5 / (3 x 0.468)) dx = 0.5672,
+          I = int_0^inf (1 + x^n)^(-5 / (3 n)) dx = Gamma(1/n) Gamma(2/(3n)) / (n Gamma(5/(3n)))
+            = 0.5672  (n = 0.468),
 
       ``g_{k+1} = a g_k + sigma sqrt(1 - a^2) n_k``, ``a = exp(-dt / T)``. (At 10 m/s: sigma =
       1.03 m/s, T = 76 s.) Its spectrum falls as ``f^-2`` where NORSOK's falls as ``f^-5/3``:
@@ -87,7 +88,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.integrate
 
 from shipgym.models import wind as _wind
 from shipgym.models._jit import kernel, row_kernel
@@ -131,9 +131,12 @@ MIN_NOMOTO_SPEED = 1.0
 """Lowest speed [m/s] at which a Nomoto-family ship's load becomes a rudder angle and leeway."""
 
 _NORSOK_N = 0.468
-_NORSOK_INTEGRAL = scipy.integrate.quad(
-    lambda x: (1.0 + x**_NORSOK_N) ** (-5.0 / (3.0 * _NORSOK_N)), 0.0, np.inf, limit=500
-)[0]
+#: ``int_0^inf (1 + x^n)^(-5 / (3 n)) dx`` of NORSOK's spectrum in closed form (substituting
+#: ``t = x^n`` makes it Euler's beta integral): ``B(1/n, 5/(3n) - 1/n) / n``.
+_NORSOK_INTEGRAL = (
+    math.gamma(1.0 / _NORSOK_N) * math.gamma(2.0 / (3.0 * _NORSOK_N))
+    / (_NORSOK_N * math.gamma(5.0 / (3.0 * _NORSOK_N)))
+)  # fmt: skip
 
 #: Kinds of ship of the compiled step: how the load enters the model.
 NOMOTO_KIND, THREE_DOF_KIND = 0, 1

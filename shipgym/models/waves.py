@@ -97,9 +97,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import scipy.linalg
-import scipy.optimize
-import scipy.special
 
 from shipgym.models._checks import real_array, require_finite, step_size
 from shipgym.models.angles import ssa
@@ -456,7 +453,9 @@ def _fitted_damping(gamma: float) -> float:
     def residual(lam: float) -> float:
         return float(np.sum((_linear_psd(w, 1.0, lam, sigma2) - target) ** 2))
 
-    fit = scipy.optimize.minimize_scalar(
+    from scipy.optimize import minimize_scalar  # here: importing shipgym stays light
+
+    fit = minimize_scalar(
         residual, bounds=_FIT_BOUNDS, method="bounded", options={"xatol": 1e-7}
     )
     return float(fit.x)
@@ -578,7 +577,9 @@ def wave_response_model(
     q = np.array([[0.0, 0.0], [0.0, math.pi * k_w * k_w]])
     # Van Loan (1978): exp([[-A, Q], [0, A^T]] dt) = [[., F12], [0, F22]], A_d = F22^T,
     # Q_d = A_d F12
-    m = scipy.linalg.expm(np.block([[-a, q], [np.zeros((2, 2)), a.T]]) * h)
+    from scipy.linalg import expm  # here: importing shipgym stays light
+
+    m = expm(np.block([[-a, q], [np.zeros((2, 2)), a.T]]) * h)
     a_d = m[2:, 2:].T
     q_d = a_d @ m[:2, 2:]
     vals, vecs = np.linalg.eigh(0.5 * (q_d + q_d.T))
@@ -701,5 +702,7 @@ def reflection_factor(sea_state: SeaState, draught: float, points: int = 400) ->
     spectrum = sea_state.spectrum(w)
     x = np.minimum(w * w / GRAVITY * d, 200.0)
     # R^2 = 1 / (1 + (K_1 / (pi I_1))^2), with the exponentially scaled Bessel functions
-    ratio = scipy.special.k1e(x) / (math.pi * scipy.special.i1e(x)) * np.exp(-2.0 * x)
+    from scipy.special import i1e, k1e  # here: importing shipgym stays light
+
+    ratio = k1e(x) / (math.pi * i1e(x)) * np.exp(-2.0 * x)
     return float(np.sum(spectrum / (1.0 + ratio * ratio)) / np.sum(spectrum))
