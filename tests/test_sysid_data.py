@@ -241,6 +241,48 @@ def test_esso_facts() -> None:
     assert random.time[0] > 1000.0  # continues the time of one long record
 
 
+def test_first_order_skips_hand_corrections_and_small_holds() -> None:
+    """A rudder moved by hand (up to 12 deg, never still), then held at 5 deg for 3 s, then a
+    20/20 zigzag: the first order is the zigzag's first 20 deg; a rudder never held has none."""
+    from shipgym.sysid.io.esso_osaka import first_order
+
+    t = np.arange(0.0, 100.0, 0.1)
+    hand = np.radians(12.0) * np.sin(2 * np.pi * t / 7.0)
+    delta = np.where(t < 30.0, hand, 0.0)
+    delta[(t >= 30.0) & (t < 33.0)] = np.radians(5.0)
+    delta[t >= 40.0] = np.radians(20.0) * np.sign(np.sin(2 * np.pi * (t[t >= 40.0] - 40.0) / 30.0)
+                                                  + 1e-9)  # fmt: skip
+    k = first_order(t, delta)
+    assert t[k] == pytest.approx(40.0)
+    assert first_order(t, hand) is None
+    assert first_order(t[:1], delta[:1]) is None
+
+
+@needs_data
+def test_esso_manoeuvres_start_at_the_programmes_first_order_not_at_a_hand_correction() -> None:
+    """Seven of the thirteen zigzag and turning runs have the helmsman's corrections reach
+    10-12 deg before the first order (five at 0.01-0.04 m/s); each manoeuvre starts at its
+    first held order, at speed."""
+    from shipgym.sysid.io.esso_osaka import ORDER_LEAD_S
+
+    orders = {"zigzag_31-Jul-2020_13_22_52.csv": 36.1, "zigzag_31-Jul-2020_13_29_19.csv": 42.6,
+              "zigzag_31-Jul-2020_13_04_24.csv": 44.2, "turn_14-Oct-2020_14_29_49.csv": 110.0,
+              "turn_14-Sep-2020_14_16_04.csv": 120.0}  # fmt: skip
+    for name, order in orders.items():
+        rec = _find(name)
+        assert rec.meta["manoeuvre_start_s"] == pytest.approx(order - ORDER_LEAD_S), name
+    for name in (f for f in FILES if "/zigzag/" in f or "/turning/" in f):
+        rec = _load(name)
+        t0, t1 = rec.meta["manoeuvre_start_s"], rec.meta["manoeuvre_end_s"]
+        run = rec.slice(t0, t1)
+        assert run.U[0] > 0.12, name  # under way, not gathering way from rest
+        # the first order: the rudder steps to the programme's amplitude and is held there
+        k = int(np.searchsorted(run.time, t0 + ORDER_LEAD_S - 1e-6))
+        assert abs(run.delta[k]) >= 0.8 * np.max(np.abs(run.delta[k : k + 600])), name
+        assert np.ptp(run.delta[k : k + 20]) < math.radians(0.3), name
+        assert np.ptp(run.delta[:k]) > 0.0, name  # the step is in the run: it excites a turn
+
+
 @needs_data
 def test_usv_facts() -> None:
     zz = _find("zigzag_30_inter_xy.csv")

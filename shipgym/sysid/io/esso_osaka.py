@@ -6,7 +6,9 @@ Conversions: the MMG convention is already starboard-positive (no flip); ``psi_h
 ``wind_velo_relative_mid`` / ``wind_dir_relative_mid``: the source angle is already "from",
 clockwise from the bow (verified against the true wind and the ship motion, residual below 0.04
 deg RMS), only wrapped from [0, 2 pi) to (-pi, pi]. Zigzag and turning runs start from rest and
-end coasting: ``meta["manoeuvre_start_s"]`` .. ``meta["manoeuvre_end_s"]`` mark the manoeuvre.
+end coasting: ``meta["manoeuvre_start_s"]`` (:data:`ORDER_LEAD_S` before the programme's first
+rudder order, :func:`first_order`) .. ``meta["manoeuvre_end_s"]`` (the last sample with the
+propeller turning) mark the manoeuvre.
 """
 
 from __future__ import annotations
@@ -30,7 +32,17 @@ from shipgym.sysid.ingest import (
 from shipgym.sysid.io.registry import SourceFormat
 from shipgym.sysid.record import Record
 
-__all__ = ["FORMAT", "by_path", "load_esso_osaka", "sniff"]
+__all__ = [
+    "FORMAT",
+    "ORDER_FRACTION",
+    "ORDER_HOLD_S",
+    "ORDER_LEAD_S",
+    "ORDER_TOLERANCE",
+    "by_path",
+    "first_order",
+    "load_esso_osaka",
+    "sniff",
+]
 
 _ESSO_COLS = [
     "t [s]",
@@ -44,6 +56,41 @@ _ESSO_COLS = [
     "delta_rudder [rad]",
 ]
 _ESSO_WIND_COLS = ["wind_velo_relative_mid [m/s]", "wind_dir_relative_mid [rad]"]
+
+ORDER_HOLD_S = 2.0
+"""A rudder order is held this long [s] within :data:`ORDER_TOLERANCE` (a hand on the tiller
+is not)."""
+ORDER_TOLERANCE = math.radians(0.25)
+"""How far [rad] a held rudder order may wander (the rudder log's resolution is 0.2-0.4 deg)."""
+ORDER_LEAD_S = 5.0
+"""The manoeuvre starts this long [s] before its first order: the rudder's step is the
+excitation (a turning circle's only one), so the approach just before it is part of the run."""
+ORDER_FRACTION = 0.8
+"""The programme's orders are held at the run's largest held rudder angle; a held angle below
+this fraction of it is a correction during the approach."""
+
+
+def first_order(t: np.ndarray, delta: np.ndarray) -> int | None:
+    """Index of a zigzag's or turn's first rudder order: the first sample from which the rudder
+    is held (:data:`ORDER_HOLD_S` within :data:`ORDER_TOLERANCE`, at 5 deg or more) at
+    :data:`ORDER_FRACTION` or more of the run's largest held angle; None without a held order.
+
+    The runs start from rest, the helmsman correcting the course by hand while the ship
+    gathers way: corrections reach 10-12 deg on seven of the thirteen runs (five of them at
+    0.01-0.04 m/s), but move all the time, where the programme steps the rudder to each order
+    and holds it for seconds."""
+    if t.size < 2:
+        return None
+    n = max(round(ORDER_HOLD_S / float(np.median(np.diff(t)))), 1)
+    if delta.size < n:
+        return None
+    windows = np.lib.stride_tricks.sliding_window_view(delta, n)
+    held = np.all(np.abs(windows - windows[:, :1]) <= ORDER_TOLERANCE, axis=1)
+    held &= np.abs(windows[:, 0]) >= math.radians(5.0)
+    k = np.flatnonzero(held)
+    if not k.size:
+        return None
+    return int(k[np.abs(delta[k]) >= ORDER_FRACTION * np.abs(delta[k]).max()][0])
 
 
 def load_esso_osaka(path: Path, say: Callable[[str], None] = silent) -> Record:
@@ -102,15 +149,15 @@ def load_esso_osaka(path: Path, say: Callable[[str], None] = silent) -> Record:
         )
     kind = path.parent.name
     if kind in ("zigzag", "turning") or path.name.startswith(("zigzag", "turn")):
-        active = np.flatnonzero(np.abs(delta) > math.radians(10.0))
+        first = first_order(t, delta)
         running = np.flatnonzero(n_prop > 0)
-        if active.size and running.size and running[-1] > active[0]:
-            meta["manoeuvre_start_s"] = float(t[active[0]])
+        if first is not None and running.size and running[-1] > first:
+            meta["manoeuvre_start_s"] = max(float(t[first]) - ORDER_LEAD_S, float(t[0]))
             meta["manoeuvre_end_s"] = float(t[running[-1]])
             meta["notes"].append(
                 "starts from rest with manual corrections and ends coasting: cut to "
-                "[manoeuvre_start_s, manoeuvre_end_s] (first |delta| > 10 deg .. last n > 0) "
-                "before fitting"
+                f"[manoeuvre_start_s, manoeuvre_end_s] ({ORDER_LEAD_S:g} s before the "
+                "programme's first rudder order .. last n > 0) before fitting"
             )
     flag_irregular(t, meta)
     return Record(
