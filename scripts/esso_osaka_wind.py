@@ -1,4 +1,4 @@
-"""Identify the Esso Osaka model from its zigzags and turns in real wind, and check the wind it
+"""Identify the Esso Osaka model from its free-running tests in real wind, and check the wind it
 finds against Blendermann's loads for the model's projected areas.
 
 Usage::
@@ -6,15 +6,17 @@ Usage::
     python scripts/esso_osaka_wind.py [--out docs] [--page docs/results/identification.md |
                                        --no-page]
 
-1. Runs ``identify`` with ``vmm:auto`` on the 9 zigzags and 4 turns of the free-running model
-   tests (``esso-osaka/zigzag/*`` and ``esso-osaka/turning/*``, as ``shipgym identify`` takes
-   them; the default hold-out), with the loop's progress.
+1. Runs ``identify`` with ``vmm:auto`` (the default hold-out, the loop's progress) twice, as
+   ``shipgym identify`` takes the runs: on the 9 zigzags and 4 turns (``esso-osaka/zigzag/*
+   esso-osaka/turning/*``) and on the whole dataset (``esso-osaka``: with the two runs of
+   random rudder orders).
 2. Fits the VMM's wind terms (``X_wc, Y_ws, N_ws, N_w2``: the apparent wind's ``(V_w/U)^2``
    times ``cos g``, ``sin g``, ``sin g``, ``sin 2g``, :mod:`shipgym.models.vmm`) by least
    squares to Blendermann's (1994) loads (:func:`shipgym.models.wind.blendermann_load`) of a
    loaded tanker with the model's projected areas (SOURCES.md: frontal 0.135 m^2, lateral
    0.520 m^2, ``L_oa`` taken as ``L_pp`` 3.0 m, the lateral area's centroid at midship) over
-   every apparent-wind angle, and sets them beside the identified ones.
+   every apparent-wind angle, and sets them beside the identified ones; and gives each
+   identified model's rudder moment arm (:func:`rudder_arm`) beside the MMG model's.
 3. Writes ``OUT/esso_wind.json``, ``OUT/esso_wind.png`` (the three loads over the apparent
    wind angle, identified and Blendermann's, with the angles the runs saw) and the page's block
    between ``<!-- esso_wind -->`` and ``<!-- /esso_wind -->``.
@@ -25,6 +27,7 @@ The data stay where they are; nothing is copied.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 import warnings
@@ -38,12 +41,18 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgym.datasets import expand_records
+from shipgym.models.mmg import MMGParams
+from shipgym.models.vmm import VMMParams, pack_vmm, vmm_forces
 from shipgym.models.wind import BLENDERMANN_COEFFICIENTS, blendermann_load
 from shipgym.sysid import identify, load
 from shipgym.sysid.report import relative_link, update_block, write_json
 
 REPO = Path(__file__).resolve().parents[1]
-RUNS = ("esso-osaka/zigzag/*", "esso-osaka/turning/*")
+#: The identifications: name -> the record arguments of ``shipgym identify``.
+SETS = {
+    "zigzags and turns": ("esso-osaka/zigzag/*", "esso-osaka/turning/*"),
+    "every run": ("esso-osaka",),
+}
 #: The model's projected wind areas [m^2] and length [m] (SOURCES.md, Miyauchi et al. 2022).
 FRONTAL_AREA, LATERAL_AREA, LENGTH = 0.135, 0.520, 3.0
 SHIP_TYPE = "tanker_loaded"
@@ -88,6 +97,53 @@ def fit_wind_terms(loads: np.ndarray) -> dict[str, float]:
     return {"X_wc": float(x), "Y_ws": float(y), "N_ws": float(n[0]), "N_w2": float(n[1])}
 
 
+def rudder_arm(params: VMMParams) -> float:
+    """The identified model's rudder moment over its side force, in ship lengths: ``dN / (L
+    dY)`` for the rudder from -2 to +2 deg in straight running at the approach speed and
+    thrust (every rudder term, its slipstream's too)."""
+    packed = pack_vmm(params)
+    u, thrust, d = params.approach_speed, params.approach_thrust(), math.radians(2.0)
+    hi, lo = (np.array(vmm_forces(u, 0.0, 0.0, s * d, thrust, 0.0, 0.0, packed)) for s in (1, -1))
+    return float((hi[2] - lo[2]) / ((hi[1] - lo[1]) * params.length))
+
+
+def mmg_rudder_arm() -> float:
+    """The MMG KVLCC2's rudder moment over its side force, in ship lengths: ``(x_R + a_H x_H) /
+    (1 + a_H)`` (Yasukawa and Yoshimura 2015, a VLCC of the Esso Osaka's form)."""
+    m = MMGParams.kvlcc2()
+    return float((m.x_r + m.a_h * m.x_h) / (1.0 + m.a_h))
+
+
+def identify_set(records: tuple[str, ...]) -> tuple[dict[str, Any], list[Any]]:
+    """One identification's summary (wind terms, errors, rudder arm) and its runs."""
+    files = expand_records(records)
+    _say(f"{len(files)} runs ({' '.join(records)}) ...")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        runs = [load(f) for f in files]
+        result = identify(runs, "vmm:auto", progress=lambda m: _say(f"  {m}"))
+    report = result.to_dict()
+    wind = next((e for e in report["effects"] if e["name"] == "wind"), None)
+    held = report["heldout"]
+    part = {
+        "command": f"shipgym identify {' '.join(records)} --model vmm:auto",
+        "runs": [Path(f).name for f in files],
+        "term_set": report["term_set_selection"]["chosen"],
+        "effects": [e["name"] for e in report["effects"]],
+        "heldout_runs": held["runs"],
+        "heldout_before": held["error_before"],
+        "heldout_after": held["error_after"],
+        "record_heading_deg": held["record_consistency"]["psi_rms_deg"],
+        "window_s": report["window_s"],
+        "identified": wind["parameters"] if wind else None,
+        "identified_training": wind["evidence"]["candidate_parameters"] if wind else None,
+        "rudder_arm_L": rudder_arm(VMMParams.from_dict(report["vmm"])),
+        "rho": report["vmm"]["rho"],
+        "length": report["vmm"]["length"],
+    }
+    return part, runs
+
+
 def _angles_seen(runs: list[Any]) -> np.ndarray:
     """The apparent-wind angles [rad] of every run's manoeuvre."""
     out = []
@@ -101,10 +157,13 @@ def _angles_seen(runs: list[Any]) -> np.ndarray:
 def plot(doc: dict[str, Any], seen: np.ndarray, path: Path) -> None:
     deg = np.degrees(_ANGLES)
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), sharex=True)
-    curves = [("identified, all runs", doc["identified"], "C0", "-"),
-              ("identified, training runs", doc["identified_training"], "C0", ":"),
-              ("Blendermann, loaded tanker", None, "k", "-"),
-              ("its best fit by the VMM's terms", doc["blendermann_terms"], "k", "--")]  # fmt: skip
+    curves = [(f"identified, {name}", part["identified"], colour, "-")
+              for (name, part), colour in zip(doc["sets"].items(), ("C0", "C2"), strict=True)
+              if part["identified"]]  # fmt: skip
+    curves += [
+        ("Blendermann, loaded tanker", None, "k", "-"),
+        ("its best fit by the VMM's terms", doc["blendermann_terms"], "k", "--"),
+    ]
     bl = np.array(doc["blendermann_loads"])
     for i, (ax, name) in enumerate(zip(axes, ("X'", "Y'", "N'"), strict=True)):
         for label, terms, colour, style in curves:
@@ -116,37 +175,63 @@ def plot(doc: dict[str, Any], seen: np.ndarray, path: Path) -> None:
         hist = ax.twinx()
         hist.hist(np.degrees(seen), bins=np.arange(-180, 181, 10), color="C1", alpha=0.2)
         hist.set_yticks([])
-    axes[0].legend(fontsize=8, loc="lower left")
+    axes[1].legend(fontsize=8, loc="upper right")
     axes[0].set_xticks(range(-180, 181, 90))
-    fig.suptitle("Esso Osaka model in real wind: the wind loads vmm:auto identifies against "
-                 "Blendermann's (orange: the angles the runs saw)", fontsize=10)  # fmt: skip
+    title = ("Esso Osaka model in real wind: the wind loads vmm:auto identifies against "
+             "Blendermann's (orange: the apparent wind angles of every run)")  # fmt: skip
+    fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
+def _errors(part: dict[str, Any]) -> str:
+    e0, e1 = part["heldout_before"], part["heldout_after"]
+    return (
+        f"heading {e0['psi_rms_deg']:.1f} -> {e1['psi_rms_deg']:.1f} deg, yaw rate "
+        f"{e0['r_rms_deg_s']:.2f} -> {e1['r_rms_deg_s']:.2f} deg/s, surge "
+        f"{e0['u_rms_m_s']:.3f} -> {e1['u_rms_m_s']:.3f} m/s, sway {e0['v_rms_m_s']:.3f} -> "
+        f"{e1['v_rms_m_s']:.3f} m/s"
+    )
+
+
 def render(doc: dict[str, Any], figure: str) -> str:
-    e0, e1 = doc["heldout_before"], doc["heldout_after"]
-    lines = [
-        f"`python scripts/esso_osaka_wind.py` ({doc['runtime_s']:.0f} s; the same as `shipgym "
-        "identify esso-osaka/zigzag/* esso-osaka/turning/* --model vmm:auto`): structure "
-        f"`{doc['term_set']}`, effects named {', '.join(doc['effects']) or 'none'}; held-out "
-        f"runs {', '.join(doc['heldout_runs'])}: heading {e0['psi_rms_deg']:.1f} -> "
-        f"{e1['psi_rms_deg']:.1f} deg, yaw rate {e0['r_rms_deg_s']:.2f} -> "
-        f"{e1['r_rms_deg_s']:.2f} deg/s, surge {e0['u_rms_m_s']:.3f} -> {e1['u_rms_m_s']:.3f} "
-        f"m/s, sway {e0['v_rms_m_s']:.3f} -> {e1['v_rms_m_s']:.3f} m/s (windows of "
-        f"{doc['window_s']:.0f} s; the record's own yaw rate, integrated, misses its heading by "
-        f"{doc['record_heading_deg']:.2f} deg there).",
+    lines = [f"`python scripts/esso_osaka_wind.py` ({doc['runtime_s']:.0f} s), two identifications "
+             "with the default hold-out:", ""]  # fmt: skip
+    for name, part in doc["sets"].items():
+        lines.append(
+            f"- **{name}** (`{part['command']}`, {len(part['runs'])} runs): structure "
+            f"`{part['term_set']}`, effects named {', '.join(part['effects']) or 'none'}; "
+            f"held-out runs {', '.join(part['heldout_runs'])}: {_errors(part)} (windows of "
+            f"{part['window_s']:.0f} s; the record's own yaw rate, integrated, misses its "
+            f"heading by {part['record_heading_deg']:.2f} deg there); the rudder's moment arm "
+            f"{part['rudder_arm_L']:.2f} L."
+        )
+    names = list(doc["sets"])
+    lines += [
         "",
-        "| wind term | identified, all runs | identified, training runs | Blendermann's, "
-        "fitted by the term | identified / Blendermann's |",
-        "|---|---:|---:|---:|---:|",
+        "| wind term | "
+        + " | ".join(f"{n}: all runs | {n}: training runs" for n in names)
+        + " | Blendermann's, fitted by the term |",
+        "|---|" + "---:|" * (2 * len(names) + 1),
     ]
     for k in WIND_TERMS:
-        a, b, c = doc["identified"][k], doc["identified_training"][k], doc["blendermann_terms"][k]
-        ratio = f"{a / c:.2f}" if abs(c) > 1e-3 * max(abs(a), 1e-12) and k != "N_ws" else "-"
-        lines.append(f"| `{k}` | {a:.3g} | {b:.3g} | {c:.3g} | {ratio} |")
-    lines += ["", f"![Esso Osaka's wind loads, identified and Blendermann's]({figure})"]
+        c = doc["blendermann_terms"][k]
+        cells = []
+        for n in names:
+            part = doc["sets"][n]
+            for key in ("identified", "identified_training"):
+                v = part[key][k] if part[key] else None
+                ratio = f" ({v / c:.2f} x)" if v is not None and k != "N_ws" else ""
+                cells.append("-" if v is None else f"{v:.3g}{ratio}")
+        lines.append(f"| `{k}` | " + " | ".join(cells) + f" | {c:.3g} |")
+    lines += [
+        "",
+        f"The MMG model's rudder moment arm, `(x_R + a_H x_H) / (1 + a_H)` of the KVLCC2: "
+        f"{doc['mmg_rudder_arm_L']:.2f} L.",
+        "",
+        f"![Esso Osaka's wind loads, identified and Blendermann's]({figure})",
+    ]
     return "\n".join(lines)
 
 
@@ -157,31 +242,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    files = expand_records(RUNS)
-    _say(f"{len(files)} runs of the Esso Osaka model ...")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        runs = [load(f) for f in files]
-        result = identify(runs, "vmm:auto", progress=lambda m: _say(f"  {m}"))
-    report = result.to_dict()
-    wind = next((e for e in report["effects"] if e["name"] == "wind"), None)
-    if wind is None:
-        _say(f"the loop named {result.effect_names}, not the wind: nothing to compare")
-        return 1
-    vmm = report["vmm"]
-    bl = blendermann_loads(float(vmm["rho"]), float(vmm["length"]))
-    held = report["heldout"]
+    sets, seen = {}, np.empty(0)
+    for name, records in SETS.items():
+        sets[name], runs = identify_set(records)
+        seen = _angles_seen(runs)  # the last set holds every run
+    first = next(iter(sets.values()))
+    bl = blendermann_loads(float(first["rho"]), float(first["length"]))
     doc = {
-        "runs": [Path(f).name for f in files],
-        "term_set": report["term_set_selection"]["chosen"],
-        "effects": [e["name"] for e in report["effects"]],
-        "heldout_runs": held["runs"],
-        "heldout_before": held["error_before"],
-        "heldout_after": held["error_after"],
-        "record_heading_deg": held["record_consistency"]["psi_rms_deg"],
-        "window_s": report["window_s"],
-        "identified": wind["parameters"],
-        "identified_training": wind["evidence"]["candidate_parameters"],
+        "sets": sets,
         "blendermann": {
             "ship_type": SHIP_TYPE,
             "frontal_area_m2": FRONTAL_AREA,
@@ -192,12 +260,13 @@ def main(argv: list[str] | None = None) -> int:
         "blendermann_terms": fit_wind_terms(bl),
         "blendermann_loads": bl.tolist(),
         "angles_deg": np.degrees(_ANGLES).tolist(),
+        "mmg_rudder_arm_L": mmg_rudder_arm(),
     }
     doc["runtime_s"] = time.perf_counter() - t0
     out = Path(args.out)
     write_json(doc, out / "esso_wind.json")
     figure = out / "esso_wind.png"
-    plot(doc, _angles_seen(runs), figure)
+    plot(doc, seen, figure)
     text = render(doc, relative_link(figure, args.page))
     print(text)
     if not args.no_page:
