@@ -37,6 +37,7 @@ __all__ = [
     "ORDER_FRACTION",
     "ORDER_HOLD_S",
     "ORDER_LEAD_S",
+    "ORDER_MIN_ANGLE",
     "ORDER_TOLERANCE",
     "by_path",
     "first_order",
@@ -65,6 +66,8 @@ ORDER_TOLERANCE = math.radians(0.25)
 ORDER_LEAD_S = 5.0
 """The manoeuvre starts this long [s] before its first order: the rudder's step is the
 excitation (a turning circle's only one), so the approach just before it is part of the run."""
+ORDER_MIN_ANGLE = math.radians(5.0)
+"""A held rudder below this [rad] is a trim, not an order."""
 ORDER_FRACTION = 0.8
 """The programme's orders are held at the run's largest held rudder angle; a held angle below
 this fraction of it is a correction during the approach."""
@@ -72,8 +75,9 @@ this fraction of it is a correction during the approach."""
 
 def first_order(t: np.ndarray, delta: np.ndarray) -> int | None:
     """Index of a zigzag's or turn's first rudder order: the first sample from which the rudder
-    is held (:data:`ORDER_HOLD_S` within :data:`ORDER_TOLERANCE`, at 5 deg or more) at
-    :data:`ORDER_FRACTION` or more of the run's largest held angle; None without a held order.
+    is held (:data:`ORDER_HOLD_S` within :data:`ORDER_TOLERANCE`, at :data:`ORDER_MIN_ANGLE` or
+    more) at :data:`ORDER_FRACTION` or more of the run's largest held angle; None without a held
+    order.
 
     The runs start from rest, the helmsman correcting the course by hand while the ship
     gathers way: corrections reach 10-12 deg on seven of the thirteen runs (five of them at
@@ -86,7 +90,7 @@ def first_order(t: np.ndarray, delta: np.ndarray) -> int | None:
         return None
     windows = np.lib.stride_tricks.sliding_window_view(delta, n)
     held = np.all(np.abs(windows - windows[:, :1]) <= ORDER_TOLERANCE, axis=1)
-    held &= np.abs(windows[:, 0]) >= math.radians(5.0)
+    held &= np.abs(windows[:, 0]) >= ORDER_MIN_ANGLE
     k = np.flatnonzero(held)
     if not k.size:
         return None
