@@ -1,4 +1,4 @@
-"""Seed 003's general 3-DOF models identified from the SIMMAN 2008 KVLCC2 and Esso Osaka records.
+"""Seed 003's general 3-DOF models identified from the SIMMAN 2008 KVLCC2 records.
 
 Usage::
 
@@ -22,9 +22,7 @@ Usage::
 3. **Trial quantities.** The VMM fitted on every run of a facility runs the standard trials of
    each record (:func:`shipgym.maneuvers.zigzag`, :func:`~shipgym.maneuvers.turning_circle`),
    beside the measurement and the published-coefficient MMG model (``docs/kvlcc2_simman.json``).
-4. **Esso Osaka.** The identification loop on all 15 pond runs, whose records carry the apparent
-   wind.
-5. **MARIN, every pair of zigzags held out.** ``identify MARIN_*.dat --model vmm:auto`` holds
+4. **MARIN, every pair of zigzags held out.** ``identify MARIN_*.dat --model vmm:auto`` holds
    out the -10 and 20 deg zigzags and chooses the term set on them; each of the six pairs of
    the four zigzags is held out here in turn (the base model of every term set fitted on the
    other four runs, scored as ``vmm:auto`` scores it), so that the choice is seen not to rest
@@ -397,17 +395,6 @@ def main(argv: list[str] | None = None) -> int:
         _fit_all(marin, best), mmg["marin"], marin, simman
     )
 
-    _say("Esso Osaka: the loop on the 15 pond runs ...")
-    esso = [r for r in _records(root, "esso_osaka_frt", "*/*.csv")]
-    esso_fit = identify(esso, f"vmm:{best}", max_effects=2)
-    esso_summary = {
-        "runs": len(esso),
-        "effects": esso_fit.effects,
-        "heldout": esso_fit.heldout,
-        "error_after": esso_fit.error_after,
-    }
-    _say(f"  effects {esso_fit.effect_names}")
-
     doc = {
         "term_sets": list(TERM_SETS),
         "median_cv_psi_rms_deg": median,
@@ -425,7 +412,6 @@ def main(argv: list[str] | None = None) -> int:
             for name, fit in mmg.items()
         },
         "trials": trials,
-        "esso": esso_summary,
         "runtime_s": time.perf_counter() - t0,
     }
     write_json(doc, out / "kvlcc2_identify.json")
@@ -548,9 +534,6 @@ def render(doc: dict[str, Any]) -> str:
                 f"{np.median(under_r):+.1f} deg (|max| {np.max(np.abs(under_r)):.1f}); factors "
                 f"at a bound: {bound}.",
             ]
-    e = doc["esso"]
-    names = ", ".join(x["name"] for x in e["effects"]) or "none"
-    lines += ["", f"Esso Osaka (15 pond runs with measured wind): effects named: {names}."]
     return "\n".join(lines)
 
 
