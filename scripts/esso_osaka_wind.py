@@ -155,6 +155,8 @@ def _angles_seen(runs: list[Any]) -> np.ndarray:
 
 
 def plot(doc: dict[str, Any], seen: np.ndarray, path: Path) -> None:
+    """The three wind loads over the apparent-wind angle: each identification's and
+    Blendermann's, over a histogram of the angles ``seen`` [rad]."""
     deg = np.degrees(_ANGLES)
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8), sharex=True)
     curves = [(f"identified, {name}", part["identified"], colour, "-")
@@ -196,6 +198,7 @@ def _errors(part: dict[str, Any]) -> str:
 
 
 def render(doc: dict[str, Any], figure: str) -> str:
+    """The page's block: each identification, the wind terms beside Blendermann's, the figure."""
     lines = [f"`python scripts/esso_osaka_wind.py` ({doc['runtime_s']:.0f} s), two identifications "
              "with the default hold-out:", ""]  # fmt: skip
     for name, part in doc["sets"].items():
@@ -242,10 +245,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-page", action="store_true", help="do not touch the page")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    sets, seen = {}, np.empty(0)
+    sets = {}
     for name, records in SETS.items():
         sets[name], runs = identify_set(records)
-        seen = _angles_seen(runs)  # the last set holds every run
+    seen = _angles_seen(runs)  # the last set, "every run", holds all of them
     first = next(iter(sets.values()))
     bl = blendermann_loads(float(first["rho"]), float(first["length"]))
     doc = {
