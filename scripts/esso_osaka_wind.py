@@ -41,10 +41,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from shipgym.datasets import expand_records
-from shipgym.models.mmg import MMGParams
+from shipgym.models.mmg import P_RUD, MMGParams, pack_mmg
 from shipgym.models.vmm import VMMParams, pack_vmm, vmm_forces
 from shipgym.models.wind import BLENDERMANN_COEFFICIENTS, blendermann_load
 from shipgym.sysid import identify, load
+from shipgym.sysid.generator import vmm_truth
 from shipgym.sysid.report import relative_link, update_block, write_json
 
 REPO = Path(__file__).resolve().parents[1]
@@ -74,27 +75,32 @@ def blendermann_loads(rho: float, length: float) -> np.ndarray:
     return loads / np.array([[q], [q], [q * length]])
 
 
-def _regressors(g: np.ndarray) -> dict[str, np.ndarray]:
-    return {"X_wc": np.cos(g), "Y_ws": np.sin(g), "N_ws": np.sin(g), "N_w2": np.sin(2.0 * g)}
+def _unit_loads(term: str, g: np.ndarray) -> np.ndarray:
+    """``(3, n)`` ``X', Y', N'`` of the VMM's wind term ``term`` with coefficient 1 at the
+    apparent wind angles ``g``, per unit ``(V_w / U)^2``: the model's own forces
+    (:func:`shipgym.models.vmm.vmm_forces`) in straight running at the approach speed, in a
+    wind of that speed, over ``rho/2 L^2 U^2`` (``rho/2 L^3 U^2`` for the moment)."""
+    params = vmm_truth().with_coefficients({term: 1.0})
+    packed, u = pack_vmm(params), params.approach_speed
+    loads = np.array([vmm_forces(u, 0.0, 0.0, 0.0, 0.0, u, a, packed) for a in g]).T
+    q = 0.5 * params.rho * params.length**2 * u * u
+    return loads / np.array([[q], [q], [q * params.length]])
 
 
 def vmm_loads(terms: dict[str, float], g: np.ndarray = _ANGLES) -> np.ndarray:
     """``(3, n)`` the VMM wind terms' ``X', Y', N'`` per unit ``(V_w / U)^2``."""
-    f = _regressors(g)
-    return np.array([
-        terms["X_wc"] * f["X_wc"],
-        terms["Y_ws"] * f["Y_ws"],
-        terms["N_ws"] * f["N_ws"] + terms["N_w2"] * f["N_w2"],
-    ])  # fmt: skip
+    return sum(v * _unit_loads(k, g) for k, v in terms.items())
 
 
 def fit_wind_terms(loads: np.ndarray) -> dict[str, float]:
-    """The VMM wind terms that fit ``loads`` (``(3, n)`` at :data:`_ANGLES`) best."""
-    f = _regressors(_ANGLES)
-    (x,), (y,) = (np.linalg.lstsq(f[k][:, None], loads[i], rcond=None)[0]
-                  for i, k in ((0, "X_wc"), (1, "Y_ws")))  # fmt: skip
-    n = np.linalg.lstsq(np.c_[f["N_ws"], f["N_w2"]], loads[2], rcond=None)[0]
-    return {"X_wc": float(x), "Y_ws": float(y), "N_ws": float(n[0]), "N_w2": float(n[1])}
+    """The VMM wind terms that fit ``loads`` (``(3, n)`` at :data:`_ANGLES`) best, each
+    equation by least squares on its own terms."""
+    out: dict[str, float] = {}
+    for eq, names in ((0, ("X_wc",)), (1, ("Y_ws",)), (2, ("N_ws", "N_w2"))):
+        a = np.column_stack([_unit_loads(k, _ANGLES)[eq] for k in names])
+        sol = np.linalg.lstsq(a, loads[eq], rcond=None)[0]
+        out |= {k: float(v) for k, v in zip(names, sol, strict=True)}
+    return out
 
 
 def rudder_arm(params: VMMParams) -> float:
@@ -109,9 +115,11 @@ def rudder_arm(params: VMMParams) -> float:
 
 def mmg_rudder_arm() -> float:
     """The MMG KVLCC2's rudder moment over its side force, in ship lengths: ``(x_R + a_H x_H) /
-    (1 + a_H)`` (Yasukawa and Yoshimura 2015, a VLCC of the Esso Osaka's form)."""
+    (1 + a_H)`` (Yasukawa and Yoshimura 2015, a VLCC of the Esso Osaka's form), as the MMG
+    model packs it (:func:`shipgym.models.mmg.pack_mmg`)."""
     m = MMGParams.kvlcc2()
-    return float((m.x_r + m.a_h * m.x_h) / (1.0 + m.a_h))
+    p = pack_mmg(m)
+    return float(p[P_RUD + 9] / (p[P_RUD + 8] * m.length))
 
 
 def identify_set(records: tuple[str, ...]) -> tuple[dict[str, Any], list[Any]]:
